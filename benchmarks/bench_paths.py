@@ -1,0 +1,79 @@
+"""Benchmark: the TREP reactionless path family (Fig. 8), rns_viz versus a solve_ivp baseline.
+
+Run on demand:  python benchmarks/bench_paths.py [--count 40] [--repeats 15]
+Prints medians (ms) of both in the same run, their ratio, and the drift of w x_cm along the
+paths as a fraction of its range over the workspace.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+import pinocchio as pin
+from scipy.integrate import solve_ivp
+
+from rns_viz.model import FsmsModel
+from rns_viz.paths import default_seeds, path_family, potential
+
+
+def solve_ivp_family(model: FsmsModel, seeds: np.ndarray, max_length: float = 60.0) -> list[np.ndarray]:
+    """The straightforward version: one DOP853 solve per seed, crba for H_bm, closure by event."""
+    q = np.zeros(model.nv)
+    m = model.m
+
+    def field(_s: float, theta: np.ndarray) -> np.ndarray:
+        q[m:] = theta
+        h = pin.crba(model.pin_model, model.data, q)[0, m:]
+        n = np.array([h[1], -h[0]])
+        return n / np.linalg.norm(n)
+
+    curves = []
+    for seed in seeds:
+        def back_home(s: float, theta: np.ndarray, seed: np.ndarray = seed) -> float:
+            d = (theta - seed + np.pi) % (2 * np.pi) - np.pi
+            return float(np.linalg.norm(d)) - 1e-3 if s > 0.5 else 1.0
+
+        back_home.terminal = True  # type: ignore[attr-defined]
+        sol = solve_ivp(field, (0.0, max_length), seed, method="DOP853", rtol=1e-9, atol=1e-12,
+                        events=back_home)
+        curves.append(sol.y.T)
+    return curves
+
+
+def median_ms(fn, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return 1e3 * statistics.median(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=40)
+    parser.add_argument("--repeats", type=int, default=15)
+    args = parser.parse_args()
+    model = FsmsModel.from_name("trep")
+    seeds = default_seeds(model, args.count)
+    ours = median_ms(lambda: path_family(model, args.count), args.repeats)
+    base = median_ms(lambda: solve_ivp_family(model, seeds), max(3, args.repeats // 3))
+    paths = path_family(model, args.count)
+    corners = np.array([[0.0, 0.0], [np.pi, 0.0]])
+    span = np.ptp([potential(model, th) for th in corners])
+    drift = max(np.ptp([potential(model, th) for th in p.theta]) for p in paths) / span
+    base_curves = solve_ivp_family(model, seeds)
+    base_drift = max(np.ptp([potential(model, th) for th in c]) for c in base_curves) / span
+    points = sum(len(p.s) for p in paths)
+    print(f"TREP path family, {args.count} curves, {points} points, ends: {sorted({p.end for p in paths})}")
+    print(f"{'method':<28}{'median ms':>10}{'w x_cm drift / range':>24}")
+    print(f"{'rns_viz path_family':<28}{ours:>10.1f}{drift:>24.1e}")
+    print(f"{'solve_ivp DOP853 baseline':<28}{base:>10.1f}{base_drift:>24.1e}")
+    print(f"speed-up over baseline: {base / ours:.1f}x")
+
+
+if __name__ == "__main__":
+    main()

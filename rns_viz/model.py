@@ -1,0 +1,207 @@
+"""FSMS model from URDF: the blocks of Eq. (1) and the end-effector kinematics, all by pinocchio.
+
+Generalised coordinates are q = (x_b, theta): the first m joints of the URDF are the elastic
+base coordinates named in the parameter file, the remaining n are the arm joints. Every
+quantity comes from pinocchio (crba, nonLinearEffects, computeCoriolisMatrix, frame
+Jacobians); nothing is hand-derived.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from rns_viz.params import ModelFileError, ModelSpec, load_spec, param_path_for
+
+_AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+
+
+@dataclass(frozen=True)
+class Terms:
+    """Dynamics and kinematics at one state (q, v); SI units, base-frame vectors."""
+
+    H_b: np.ndarray  # (m, m) base inertia, kg or kg m^2
+    H_bm: np.ndarray  # (m, n) inertia coupling matrix, Eq. (1)
+    H_m: np.ndarray  # (n, n) arm inertia
+    c_b: np.ndarray  # (m,) velocity terms, base rows of Eq. (1)
+    c_m: np.ndarray  # (n,) velocity terms, arm rows
+    hbm_dot_thetadot: np.ndarray  # (m,) H_bm' theta', Eq. (5)
+    coupling_momentum: np.ndarray  # (m,) L = H_bm theta', Eq. (8)
+    J: np.ndarray  # (p, n) end-effector Jacobian in the base frame, Eq. (21)
+    Jdot_thetadot: np.ndarray  # (p,) J' theta' in the base frame
+    ee: np.ndarray  # (3,) end-effector position in the base frame, m
+
+
+class FsmsModel:
+    """A serial arm on an m-DOF elastic base (1 <= m <= 6), built from URDF + parameter file."""
+
+    def __init__(self, spec: ModelSpec) -> None:
+        self.spec = spec
+        self.pin_model = _build_pinocchio_model(spec)
+        self.data = self.pin_model.createData()
+        model = self.pin_model
+        self.m = spec.base.dof
+        self.n = model.nv - self.m
+        names = list(model.names)[1:]
+        if names[: self.m] != list(spec.base.joints):
+            raise ModelFileError(
+                f"{spec.param_path}: [base] joints {list(spec.base.joints)} must be the first "
+                f"joints of {spec.urdf_path.name}, which are {names[: self.m]}"
+            )
+        if model.nq != model.nv or any(j.nv != 1 for j in model.joints[1:]):
+            raise ModelFileError(
+                f"{spec.urdf_path}: every joint must be prismatic or revolute with one coordinate "
+                "(use 'revolute' with wide limits instead of 'continuous')"
+            )
+        if self.n < 1 or spec.default_configuration.size != self.n:
+            raise ModelFileError(
+                f"{spec.param_path}: [model] default_configuration_deg has "
+                f"{spec.default_configuration.size} angles, the arm has {self.n} joints"
+            )
+        if not model.existFrame(spec.ee_frame):
+            raise ModelFileError(f"{spec.urdf_path}: no link or frame named {spec.ee_frame!r} (ee_frame)")
+        self.ee_frame_id = model.getFrameId(spec.ee_frame)
+        self.base_joint_id = self.m  # pinocchio joint index of the last base joint
+        self.arm_joint_names: tuple[str, ...] = tuple(names[self.m :])
+        self.selected = np.flatnonzero(spec.base.selection)
+        self.task_rows = np.array([_AXIS_INDEX[a] for a in spec.task_axes])
+        self.lower = model.lowerPositionLimit[self.m :].copy()
+        self.upper = model.upperPositionLimit[self.m :].copy()
+        self.K_b = spec.base.stiffness
+        self.D_b = spec.base.damping
+        self.D_m = np.diag(spec.joint_damping)
+        self.arm_mass = float(sum(model.inertias[i].mass for i in range(self.m + 1, model.njoints)))
+        self.base_is_translational = all(model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1))
+
+    @classmethod
+    def from_name(cls, name: str) -> FsmsModel:
+        """A bundled model: ``trep`` or ``planar3r``."""
+        return cls(load_spec(param_path_for(name)))
+
+    @classmethod
+    def from_file(cls, param_path: str | Path) -> FsmsModel:
+        return cls(load_spec(param_path))
+
+    # -- coordinates ---------------------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def nv(self) -> int:
+        return self.m + self.n
+
+    def q(self, theta: np.ndarray, x_b: np.ndarray | None = None) -> np.ndarray:
+        """Stack (x_b, theta) into pinocchio's configuration vector."""
+        xb = np.zeros(self.m) if x_b is None else np.asarray(x_b, dtype=float)
+        return np.concatenate([xb, np.asarray(theta, dtype=float)])
+
+    # -- dynamics ------------------------------------------------------------------------------
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """Joint-space inertia matrix of Eq. (1), full and symmetric."""
+        return pin.crba(self.pin_model, self.data, q)
+
+    def coupling_matrix(self, q: np.ndarray) -> np.ndarray:
+        """S H_bm: the rows of the inertia coupling matrix selected by S (Sec. III-B)."""
+        return self.mass_matrix(q)[self.selected, self.m :]
+
+    def terms(self, q: np.ndarray, v: np.ndarray) -> Terms:
+        """All blocks of Eq. (1) and the end-effector kinematics of Eq. (21) at (q, v)."""
+        model, data, m = self.pin_model, self.data, self.m
+        M = pin.crba(model, data, q).copy()
+        c = pin.nonLinearEffects(model, data, q, v).copy()
+        C = pin.computeCoriolisMatrix(model, data, q, v)
+        M_dot = C + C.T  # M' = C + C^T for pinocchio's Coriolis matrix
+        thetadot = v[m:]
+        J, Jdot_thetadot, ee = self._ee_kinematics(q, thetadot)
+        return Terms(
+            H_b=M[:m, :m],
+            H_bm=M[:m, m:],
+            H_m=M[m:, m:],
+            c_b=c[:m],
+            c_m=c[m:],
+            hbm_dot_thetadot=M_dot[:m, m:] @ thetadot,
+            coupling_momentum=M[:m, m:] @ thetadot,
+            J=J,
+            Jdot_thetadot=Jdot_thetadot,
+            ee=ee,
+        )
+
+    # -- kinematics ----------------------------------------------------------------------------
+    def _ee_kinematics(self, q: np.ndarray, thetadot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """J, J' theta' and the end-effector position, all relative to and in the base frame."""
+        model, data, m = self.pin_model, self.data, self.m
+        v_rel = np.concatenate([np.zeros(m), thetadot])
+        pin.forwardKinematics(model, data, q, v_rel, np.zeros(model.nv))
+        pin.updateFramePlacement(model, data, self.ee_frame_id)
+        base = data.oMi[self.base_joint_id]
+        R = base.rotation
+        ee_world = data.oMf[self.ee_frame_id].translation
+        acc = pin.getFrameClassicalAcceleration(model, data, self.ee_frame_id, pin.LOCAL_WORLD_ALIGNED).linear
+        J_world = pin.computeFrameJacobian(model, data, q, self.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
+        rows = self.task_rows
+        return (R.T @ J_world)[rows], (R.T @ acc)[rows], R.T @ (ee_world - base.translation)
+
+    def ee_position(self, theta: np.ndarray) -> np.ndarray:
+        """End-effector position in the base frame, m (forward kinematics by pinocchio)."""
+        q = self.q(theta)
+        pin.forwardKinematics(self.pin_model, self.data, q)
+        pin.updateFramePlacement(self.pin_model, self.data, self.ee_frame_id)
+        base = self.data.oMi[self.base_joint_id]
+        return base.rotation.T @ (self.data.oMf[self.ee_frame_id].translation - base.translation)
+
+    def ee_positions(self, thetas: np.ndarray) -> np.ndarray:
+        """End-effector positions (K, 3) in the base frame for K configurations (K, n), x_b = 0, m."""
+        model, data, fid, q = self.pin_model, self.data, self.ee_frame_id, np.zeros(self.nv)
+        out = np.empty((len(thetas), 3))
+        for k, theta in enumerate(thetas):
+            q[self.m :] = theta
+            pin.forwardKinematics(model, data, q)
+            out[k] = pin.updateFramePlacement(model, data, fid).translation
+        base = data.oMi[self.base_joint_id]  # the base frame does not depend on theta
+        return (out - base.translation) @ base.rotation
+
+    def ee_jacobian(self, theta: np.ndarray) -> np.ndarray:
+        """Task rows of the end-effector Jacobian in the base frame, (p, n)."""
+        return self._ee_kinematics(self.q(theta), np.zeros(self.n))[0]
+
+    def arm_mass_moment(self, theta: np.ndarray) -> np.ndarray:
+        """w r_cm: arm mass times arm centre of mass, in the base frame (kg m).
+
+        For a translating base its component along a base axis is a potential of that row of
+        H_bm (Eq. 26), so reactionless paths are its level sets.
+        """
+        q = self.q(theta)
+        model, data = self.pin_model, self.data
+        pin.forwardKinematics(model, data, q)
+        moment = sum(
+            model.inertias[i].mass * data.oMi[i].act(model.inertias[i].lever) for i in range(self.m + 1, model.njoints)
+        )
+        base = data.oMi[self.base_joint_id]
+        return base.rotation.T @ (moment - self.arm_mass * base.translation)
+
+    def base_axes(self) -> np.ndarray:
+        """Unit axes of the base joints, (m, 3), in the base frame (translational bases)."""
+        axes = []
+        for i in range(1, self.m + 1):
+            S = self.pin_model.joints[i].shortname()
+            axis = {"X": [1, 0, 0], "Y": [0, 1, 0], "Z": [0, 0, 1]}.get(S[-1])
+            if axis is None:  # JointModelPrismaticUnaligned
+                axis = list(self.pin_model.joints[i].extract().axis)
+            axes.append(axis)
+        return np.array(axes, dtype=float)
+
+
+def _build_pinocchio_model(spec: ModelSpec) -> pin.Model:
+    path = spec.urdf_path
+    if not path.is_file():
+        raise ModelFileError(f"{spec.param_path}: [model] urdf: no file {path}")
+    try:
+        model = pin.buildModelFromUrdf(str(path))
+    except (RuntimeError, ValueError) as exc:
+        raise ModelFileError(f"{path}: pinocchio cannot read this URDF ({str(exc).strip()})") from None
+    model.gravity.linear[:] = spec.gravity
+    return model

@@ -1,0 +1,138 @@
+"""Model parameter files: one TOML file per model, beside its URDF in ``assets/``.
+
+The URDF holds geometry and mass (the single source for dynamics and drawing); the parameter
+file holds what a URDF cannot say: which joints are the elastic base coordinates x_b, their
+stiffness K_b and damping D_b, the selection S of the selective RNS (Sec. III-B), arm joint
+damping D_m, the task axes of the end-effector Jacobian and the default configuration.
+
+Units are SI: K_b in N/m (prismatic base coordinate) or N m/rad (revolute), D_b in N s/m or
+N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends in ``_deg``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
+MODEL_NAMES = ("trep", "planar3r")
+TASK_AXES = ("x", "y", "z")
+
+
+class ModelFileError(ValueError):
+    """A URDF or parameter file that cannot be used; the message names the file and element."""
+
+
+@dataclass(frozen=True)
+class BaseSpec:
+    """Elastic base: x_b coordinates with H_b x_b'' + D_b x_b' + K_b x_b = ... (Eq. 1)."""
+
+    joints: tuple[str, ...]
+    stiffness: np.ndarray  # K_b, (m, m), N/m or N m/rad
+    damping: np.ndarray  # D_b, (m, m), N s/m or N m s/rad
+    selection: np.ndarray  # diag of S, (m,), bool: True = zero reaction required
+
+    @property
+    def dof(self) -> int:
+        return len(self.joints)
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """Everything needed to build an FSMS model besides the URDF itself."""
+
+    name: str
+    urdf_path: Path
+    param_path: Path
+    ee_frame: str
+    task_axes: tuple[str, ...]
+    default_configuration: np.ndarray  # theta_0, rad
+    gravity: np.ndarray  # m/s^2, world frame
+    base: BaseSpec
+    joint_damping: np.ndarray  # D_m diagonal, N m s/rad
+
+
+def param_path_for(name: str) -> Path:
+    """The parameter file of a bundled model, by name."""
+    if name not in MODEL_NAMES:
+        raise ModelFileError(f"unknown model {name!r}; choose one of: {', '.join(MODEL_NAMES)}")
+    return ASSETS_DIR / f"{name}.toml"
+
+
+def _get(table: dict, key: str, where: str, path: Path) -> object:
+    if key not in table:
+        raise ModelFileError(f"{path}: missing [{where}] {key}")
+    return table[key]
+
+
+def _matrix(value: object, shape: tuple[int, int], element: str, path: Path) -> np.ndarray:
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ModelFileError(f"{path}: {element} must be numbers ({exc})") from None
+    if arr.shape != shape:
+        raise ModelFileError(f"{path}: {element} must have shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ModelFileError(f"{path}: {element} must be finite")
+    return arr
+
+
+def load_spec(param_path: str | Path) -> ModelSpec:
+    """Read and check a parameter file; the URDF path inside is relative to the file."""
+    path = Path(param_path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise ModelFileError(f"{path}: cannot read ({exc.strerror})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelFileError(f"{path}: not valid TOML ({exc})") from None
+    model = _get(data, "model", "", path)
+    base = _get(data, "base", "", path)
+    arm = data.get("arm", {})
+    if not isinstance(model, dict) or not isinstance(base, dict) or not isinstance(arm, dict):
+        raise ModelFileError(f"{path}: [model], [base] and [arm] must be tables")
+
+    joints = _get(base, "joints", "base", path)
+    if not (isinstance(joints, list) and joints and all(isinstance(j, str) for j in joints)):
+        raise ModelFileError(f"{path}: [base] joints must be a non-empty list of joint names")
+    m = len(joints)
+    if m > 6:
+        raise ModelFileError(f"{path}: [base] joints: at most 6 elastic base coordinates, got {m}")
+    stiffness = _matrix(_get(base, "stiffness", "base", path), (m, m), "[base] stiffness", path)
+    damping = _matrix(base.get("damping", np.zeros((m, m)).tolist()), (m, m), "[base] damping", path)
+    selection = _matrix([base.get("selection", [1] * m)], (1, m), "[base] selection", path)[0]
+    if not np.all((selection == 0) | (selection == 1)) or not selection.any():
+        raise ModelFileError(f"{path}: [base] selection must be 0/1 flags with at least one 1")
+
+    theta0_deg = np.array(_get(model, "default_configuration_deg", "model", path), dtype=float)
+    n = theta0_deg.size
+    joint_damping = _matrix([arm.get("joint_damping", [0.0] * n)], (1, n), "[arm] joint_damping", path)[0]
+    axes = tuple(model.get("task_axes", ["x", "y"]))
+    if not axes or any(a not in TASK_AXES for a in axes) or len(set(axes)) != len(axes):
+        raise ModelFileError(f"{path}: [model] task_axes must be distinct names from {TASK_AXES}")
+    gravity = _matrix([model.get("gravity_m_per_s2", [0.0, 0.0, 0.0])], (1, 3), "[model] gravity_m_per_s2", path)[0]
+    urdf = _get(model, "urdf", "model", path)
+    if not isinstance(urdf, str):
+        raise ModelFileError(f"{path}: [model] urdf must be a file name")
+    if not np.all(np.isfinite(theta0_deg)):
+        raise ModelFileError(f"{path}: [model] default_configuration_deg must be finite")
+    return ModelSpec(
+        name=str(model.get("name", path.stem)),
+        urdf_path=(path.parent / urdf).resolve(),
+        param_path=path.resolve(),
+        ee_frame=str(_get(model, "ee_frame", "model", path)),
+        task_axes=axes,
+        default_configuration=np.deg2rad(theta0_deg),
+        gravity=gravity,
+        base=BaseSpec(tuple(joints), stiffness, damping, selection.astype(bool)),
+        joint_damping=joint_damping,
+    )
+
+
+def natural_frequency_hz(stiffness: float, mass: float) -> float:
+    """Undamped frequency sqrt(k/m)/(2 pi) of a locked-arm base, Hz."""
+    return math.sqrt(stiffness / mass) / (2.0 * math.pi)
