@@ -32,13 +32,13 @@ def solve_ivp_family(model: FsmsModel, seeds: np.ndarray, max_length: float = 60
 
     curves = []
     for seed in seeds:
+
         def back_home(s: float, theta: np.ndarray, seed: np.ndarray = seed) -> float:
             d = (theta - seed + np.pi) % (2 * np.pi) - np.pi
             return float(np.linalg.norm(d)) - 1e-3 if s > 0.5 else 1.0
 
         back_home.terminal = True  # type: ignore[attr-defined]
-        sol = solve_ivp(field, (0.0, max_length), seed, method="DOP853", rtol=1e-9, atol=1e-12,
-                        events=back_home)
+        sol = solve_ivp(field, (0.0, max_length), seed, method="DOP853", rtol=1e-9, atol=1e-12, events=back_home)
         curves.append(sol.y.T)
     return curves
 

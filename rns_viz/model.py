@@ -74,7 +74,9 @@ class FsmsModel:
         self.D_b = spec.base.damping
         self.D_m = np.diag(spec.joint_damping)
         self.arm_mass = float(sum(model.inertias[i].mass for i in range(self.m + 1, model.njoints)))
-        self.base_is_translational = all(model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1))
+        self.base_is_translational = all(
+            model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1)
+        )
 
     @classmethod
     def from_name(cls, name: str) -> FsmsModel:

@@ -126,11 +126,12 @@ def trace_paths(
     tangent turns at most MAX_TURN over it. Joints whose limits span at least a
     full turn are periodic: a curve closes when it returns to its seed modulo 2 pi.
     A translating base has a potential of the coupling momentum, w x_cm (Eq. 26), constant on
-    every reactionless path: there each RK4 step is followed by a Newton step along H_bm back
-    onto the seed's level (a projection method, Hairer et al., Geometric Numerical Integration
-    IV.4), which keeps the invariant to rounding instead of letting it drift.
+    every reactionless path: there a Heun predictor is followed by a Newton and a chord step
+    along H_bm back onto the seed's level (a projection method, Hairer et al., Geometric
+    Numerical Integration IV.4), which keeps the invariant to rounding instead of letting it
+    drift. Other bases take plain RK4 steps.
     ``singular_norm`` (units of |n|) stops a curve near rank loss of H_bm; by default it is
-    1e-3 of the largest |n| seen at the seeds.
+    1e-2 of the largest |n| seen at the seeds.
     """
     if not (np.isfinite(ds) and ds > 0):
         raise ValueError(f"ds must be a positive step in rad, got {ds}")
@@ -138,7 +139,7 @@ def trace_paths(
     field = _NullField(model)
     seed_norm = field(seeds)[1]
     if singular_norm is None:
-        singular_norm = 1e-3 * max(float(seed_norm.max()), 1e-300)
+        singular_norm = 1e-2 * max(float(seed_norm.max()), 1e-300)
     forward = _trace_one_way(model, field, seeds, ds, max_length, singular_norm, +1.0)
     open_idx = [k for k, f in enumerate(forward) if f[1] != "closed"]
     backward = _trace_one_way(model, field, seeds[open_idx], ds, max_length, singular_norm, -1.0) if open_idx else []
@@ -179,20 +180,30 @@ def _trace_one_way(
     while active.size:
         k1 *= sign
         hk = h[active][:, None]
-        k2 = sign * field(th + 0.5 * hk * k1)[0]
-        k3 = sign * field(th + 0.5 * hk * k2)[0]
-        k4 = sign * field(th + hk * k3)[0]
-        new = th + hk / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)  # RK4
-        k1_next, n1_next, H, pot = field(new, want_potential=True)
-        if levels is not None:  # Newton corrector onto the seed's level: new -= H^+ (c(new) - c_seed)
+        if levels is None:  # RK4 on d theta/ds = n/|n|
+            k2, n2, _, _ = field(th + 0.5 * hk * k1)
+            k3, n3, _, _ = field(th + 0.5 * hk * sign * k2)
+            k4, n4, _, _ = field(th + hk * sign * k3)
+            k2, k3, k4 = sign * k2, sign * k3, sign * k4
+            new = th + hk / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            smallest = np.minimum(np.minimum(n1, n2), np.minimum(n3, n4))
+            k1_next, n1_next, _, _ = field(new)
+        else:  # Heun predictor, then Newton + chord corrector onto the seed's level c(theta) = c_seed
+            k4, n4, _, _ = field(th + hk * k1)
+            k4 *= sign
+            new = th + 0.5 * hk * (k1 + k4)
+            smallest = np.minimum(n1, n4)
+            k1_next, n1_next, H, pot = field(new, want_potential=True)
             new -= _right_inverse_times(H, pot - levels[active])
-            new -= _right_inverse_times(H, field.potentials(new) - levels[active])  # chord step
+            for _chord in range(2):
+                new -= _right_inverse_times(H, field.potentials(new) - levels[active])
+        smallest = np.minimum(smallest, n1_next)
         turn = np.sqrt(np.einsum("ij,ij->i", k4 - k1, k4 - k1))  # tangent turn over the step, rad
         delta = new - seeds[active]
         delta[:, periodic] = (delta[:, periodic] + np.pi) % TWO_PI - np.pi
         dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
         length[active] += hk[:, 0]
-        singular = n1 < singular_norm
+        singular = smallest < singular_norm
         outside = np.any(~periodic & ((new < lower) | (new > upper)), axis=1) & ~singular
         closed = left_seed[active] & (dist < 0.6 * hk[:, 0]) & ~singular & ~outside
         too_long = (length[active] >= max_length) & ~singular & ~outside & ~closed
@@ -200,10 +211,19 @@ def _trace_one_way(
         kept = ~(singular | outside)
         recorded_idx.append(active[kept])
         recorded_pts.append(new[kept])
-        for mask, why in ((singular, "singularity"), (outside, "joint limit"), (closed, "closed"), (too_long, "max length")):
+        for mask, why in (
+            (singular, "singularity"),
+            (outside, "joint limit"),
+            (closed, "closed"),
+            (too_long, "max length"),
+        ):
             ends[active[mask]] = why
         left_seed[active] |= dist > 2.0 * hk[:, 0]
-        h[active] = np.clip(hk[:, 0] * MAX_TURN / np.maximum(turn, 1e-12), ds / 64.0, ds)
+        # Shorten the step where the tangent turns fast, and where |n| falls (a singularity ahead):
+        # never step more than half the estimated distance to |n| = 0.
+        falling = np.maximum(n1 - n1_next, 1e-300) / hk[:, 0]
+        h_next = np.minimum(hk[:, 0] * MAX_TURN / np.maximum(turn, 1e-12), 0.5 * n1_next / falling)
+        h[active] = np.clip(h_next, ds / 64.0, ds)
         go_on = ~(singular | outside | closed | too_long)
         active, th, k1, n1 = active[go_on], new[go_on], k1_next[go_on], n1_next[go_on]
     idx = np.concatenate(recorded_idx)
@@ -302,7 +322,7 @@ def reactionless_reachable_set(
     frontier = start
     while len(frontier) and len(accepted) < max_points:
         H, _ = field.rows_at(frontier)
-        _, sv, Vt = np.linalg.svd(H)
+        _, _, Vt = np.linalg.svd(H)
         r = H.shape[1]
         basis = np.transpose(Vt[:, r:, :], (0, 2, 1))  # (F, n, k) orthonormal null-space bases
         steps = np.concatenate([basis, -basis], axis=2) * spacing

@@ -125,7 +125,7 @@ def check_integrability(
     rns_dim = 0
     for theta in np.atleast_2d(samples):
         P = rns_projector(coupling(theta))
-        rns_dim = int(round(np.trace(P)))
+        rns_dim = round(float(np.trace(P)))
         n = theta.size
         for i in range(n):
             for j in range(i + 1, n):

@@ -1,0 +1,64 @@
+"""The console script: JSON info, CSV paths, and one-line errors for bad arguments."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.closed_forms import trep_ee
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "rns_viz.cli", *args], capture_output=True, text=True, timeout=120)
+
+
+@pytest.mark.parametrize(("model", "m", "n", "hb"), [("trep", 1, 2, 1.225), ("planar3r", 1, 3, 31.0)])
+def test_info(model: str, m: int, n: int, hb: float) -> None:
+    result = run("info", "--model", model)
+    assert result.returncode == 0, result.stderr
+    info = json.loads(result.stdout)
+    assert info["model"] == model and info["base_dof"] == m and info["arm_dof"] == n
+    assert len(info["arm_joints"]) == n and len(info["default_configuration_rad"]) == n
+    assert info["H_b_kg"][0] == pytest.approx([hb])
+    assert np.array(info["K_b_N_per_m"]).shape == (m, m)
+    assert Path(info["urdf"]).is_file()
+
+
+def test_paths_csv(tmp_path: Path) -> None:
+    out = tmp_path / "paths.csv"
+    result = run("paths", "--model", "trep", "--count", "6", "--csv", str(out))
+    assert result.returncode == 0, result.stderr
+    with out.open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert list(rows[0]) == ["path", "s", "theta_1", "theta_2", "ee_x", "ee_y", "ee_z"]
+    assert {int(r["path"]) for r in rows} == set(range(6))
+    for r in rows[::7]:
+        theta = np.array([float(r["theta_1"]), float(r["theta_2"])])
+        ee = np.array([float(r["ee_x"]), float(r["ee_y"]), float(r["ee_z"])])
+        np.testing.assert_allclose(ee, trep_ee(theta), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["info", "--model", "nope"], "invalid choice"),
+        (["paths", "--count", "0", "--csv", "x.csv"], "at least 1"),
+        (["paths", "--count", "-3", "--csv", "x.csv"], "at least 1"),
+        (["paths", "--count", "many", "--csv", "x.csv"], "whole number"),
+        (["paths", "--csv", "/no/such/dir/x.csv"], "cannot write"),
+        (["paths", "--model", "planar3r", "--csv", "PLACEHOLDER"], "1-D RNS"),
+    ],
+)
+def test_bad_arguments_give_one_clear_line(args: list[str], fragment: str, tmp_path: Path) -> None:
+    args = [str(tmp_path / "x.csv") if a == "PLACEHOLDER" else a for a in args]
+    result = run(*args)
+    assert result.returncode != 0
+    assert "Traceback" not in result.stderr
+    assert fragment in result.stderr
+    assert result.stderr.strip().splitlines()[-1].startswith(("rns-viz", "usage"))

@@ -1,0 +1,99 @@
+"""Reaction null-space maths: projector, null vector, damped inverse, integrability."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rns_viz.model import FsmsModel
+from rns_viz.rns import check_integrability, damped_pinv, null_vector, restricted_jacobian, rns_projector
+
+RNG = np.random.default_rng(3)
+
+
+@pytest.mark.parametrize("name", ["trep", "planar3r"])
+def test_projector_is_orthogonal_and_annihilates_hbm(name: str) -> None:
+    model = FsmsModel.from_name(name)
+    for _ in range(100):
+        theta = RNG.uniform(-np.pi, np.pi, model.n)
+        H = model.coupling_matrix(model.q(theta))
+        P = rns_projector(H)
+        np.testing.assert_allclose(P, P.T, atol=1e-15)
+        np.testing.assert_allclose(P @ P, P, atol=1e-14)
+        np.testing.assert_allclose(H @ P, 0.0, atol=1e-15 * max(1.0, np.abs(H).max()))
+        assert np.trace(P) == pytest.approx(model.n - 1)
+
+
+def test_null_vector_is_eq27_and_orthogonal(trep: FsmsModel) -> None:
+    for _ in range(100):
+        theta = RNG.uniform(-np.pi, np.pi, 2)
+        h = trep.coupling_matrix(trep.q(theta))
+        n = null_vector(h)
+        np.testing.assert_array_equal(n, [h[0, 1], -h[0, 0]])
+        assert abs(h[0] @ n) < 1e-18
+
+
+def test_generalised_null_vector_for_two_rows() -> None:
+    for _ in range(50):
+        H = RNG.normal(size=(2, 3))
+        n = null_vector(H)
+        np.testing.assert_allclose(H @ n, 0.0, atol=1e-14)
+        np.testing.assert_allclose(n, np.cross(H[0], H[1]), atol=1e-14)
+
+
+def test_damped_pinv_matches_pinv_away_from_singularity() -> None:
+    for rows in (1, 2):
+        A = RNG.normal(size=(rows, 3))
+        inv = damped_pinv(A)
+        np.testing.assert_allclose(inv.inverse, np.linalg.pinv(A), atol=1e-13)
+        assert inv.damping == 0.0
+        assert inv.sigma_min == pytest.approx(np.linalg.svd(A, compute_uv=False)[-1])
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-12, 1e-8, 1e-5, 1e-3])
+@pytest.mark.parametrize("theta2", [0.0, np.pi])
+def test_damped_pinv_stays_finite_at_trep_singularity(trep: FsmsModel, offset: float, theta2: float) -> None:
+    """Arm stretched or folded along x: H_bm = 0 there, and the inverse must stay bounded."""
+    theta = np.array([offset, theta2])
+    h = trep.coupling_matrix(trep.q(theta))
+    inv = damped_pinv(h)
+    assert np.all(np.isfinite(inv.inverse))
+    bound = 1.0 / (2 * inv.damping) if inv.damping > 0 else 1.0 / inv.sigma_min
+    assert np.abs(inv.inverse).max() <= bound * (1 + 1e-12)
+    assert inv.sigma_min == pytest.approx(np.linalg.norm(h), abs=1e-18)
+    assert inv.sigma_min < 1e-3 * 0.06  # the reported distance to singularity is small here
+
+
+def test_damped_pinv_bound() -> None:
+    """|A^+| <= 1 / (2 lambda) for the damped inverse, whatever sigma."""
+    for sigma in (0.0, 1e-9, 1e-6, 5e-4):
+        A = np.array([[sigma, 0.0]])
+        inv = damped_pinv(A)
+        assert np.all(np.isfinite(inv.inverse))
+        assert np.abs(inv.inverse).max() <= 1.0 / (2 * inv.damping) + 1e-12
+
+
+def test_restricted_jacobian_lies_in_rns(planar3r: FsmsModel) -> None:
+    theta = planar3r.spec.default_configuration
+    terms = planar3r.terms(planar3r.q(theta), np.zeros(4))
+    P = rns_projector(terms.H_bm)
+    Jbar = restricted_jacobian(terms.J, P)
+    np.testing.assert_allclose(terms.H_bm @ np.linalg.pinv(Jbar), 0.0, atol=1e-12)  # J-bar^+ eta in N(H_bm)
+    assert np.linalg.matrix_rank(Jbar) == 2
+
+
+def test_integrability(trep: FsmsModel, planar3r: FsmsModel) -> None:
+    samples2 = RNG.uniform(-np.pi, np.pi, (10, 2))
+    samples3 = RNG.uniform(-np.pi, np.pi, (10, 3))
+    trep_result = check_integrability(lambda th: trep.coupling_matrix(trep.q(th)), samples2)
+    assert trep_result.integrable and trep_result.rns_dim == 1
+    r3 = check_integrability(lambda th: planar3r.coupling_matrix(planar3r.q(th)), samples3)
+    # Translating base: the RNS is tangent to the level sets of w x_cm, hence involutive.
+    assert r3.integrable and r3.rns_dim == 2 and r3.max_residual < 1e-6
+
+
+def test_integrability_detects_a_nonholonomic_distribution() -> None:
+    """ker(dz - y dx) is the textbook non-involutive distribution: [X, Y] leaves it."""
+    result = check_integrability(lambda th: np.array([[-th[1], 0.0, 1.0]]), RNG.normal(size=(5, 3)))
+    assert not result.integrable
+    assert result.max_residual > 0.1
