@@ -77,6 +77,7 @@ class FsmsModel:
         self.base_is_translational = all(
             model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1)
         )
+        self._cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
 
     @classmethod
     def from_name(cls, name: str) -> FsmsModel:
@@ -110,6 +111,20 @@ class FsmsModel:
         """S H_bm: the rows of the inertia coupling matrix selected by S (Sec. III-B)."""
         return self.mass_matrix(q)[self.selected, self.m :]
 
+    def dynamics(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """M, the velocity terms c = (c_b, c_m) and H_bm' theta' at (q, v): what the laws need.
+
+        For a translating base without gravity c_b is exactly H_bm' theta' (M does not depend
+        on x_b), which saves the Coriolis matrix; otherwise H_bm' comes from M' = C + C^T.
+        """
+        model, data, m = self.pin_model, self.data, self.m
+        M = pin.crba(model, data, q).copy()
+        c = pin.nonLinearEffects(model, data, q, v).copy()
+        if self._cb_is_hbm_dot:
+            return M, c, c[:m].copy()
+        C = pin.computeCoriolisMatrix(model, data, q, v)
+        return M, c, (C + C.T)[:m, m:] @ v[m:]
+
     def terms(self, q: np.ndarray, v: np.ndarray) -> Terms:
         """All blocks of Eq. (1) and the end-effector kinematics of Eq. (21) at (q, v)."""
         model, data, m = self.pin_model, self.data, self.m
@@ -118,7 +133,7 @@ class FsmsModel:
         C = pin.computeCoriolisMatrix(model, data, q, v)
         M_dot = C + C.T  # M' = C + C^T for pinocchio's Coriolis matrix
         thetadot = v[m:]
-        J, Jdot_thetadot, ee = self._ee_kinematics(q, thetadot)
+        J, Jdot_thetadot, ee = self.ee_kinematics(q, thetadot)
         return Terms(
             H_b=M[:m, :m],
             H_bm=M[:m, m:],
@@ -133,7 +148,7 @@ class FsmsModel:
         )
 
     # -- kinematics ----------------------------------------------------------------------------
-    def _ee_kinematics(self, q: np.ndarray, thetadot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def ee_kinematics(self, q: np.ndarray, thetadot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """J, J' theta' and the end-effector position, all relative to and in the base frame."""
         model, data, m = self.pin_model, self.data, self.m
         v_rel = np.concatenate([np.zeros(m), thetadot])
@@ -168,7 +183,7 @@ class FsmsModel:
 
     def ee_jacobian(self, theta: np.ndarray) -> np.ndarray:
         """Task rows of the end-effector Jacobian in the base frame, (p, n)."""
-        return self._ee_kinematics(self.q(theta), np.zeros(self.n))[0]
+        return self.ee_kinematics(self.q(theta), np.zeros(self.n))[0]
 
     def arm_mass_moment(self, theta: np.ndarray) -> np.ndarray:
         """w r_cm: arm mass times arm centre of mass, in the base frame (kg m).

@@ -1,0 +1,35 @@
+"""The paper's control laws, one module each, one call signature: law(t, q, v) -> ControlOutput."""
+
+from rns_viz.control.acceleration import AccelerationLaw
+from rns_viz.control.common import ControlLaw, ControlOutput, Gains, InvalidGain
+from rns_viz.control.hold import JointServo, Switched
+from rns_viz.control.null_input import (
+    DampNullMotion,
+    MovableTarget,
+    TaskQuintic,
+    TrackEndEffector,
+    TrackJointReference,
+)
+from rns_viz.control.reference import FixedReference, JointQuintic, PathReference
+from rns_viz.control.torque import TorqueLaw
+from rns_viz.control.velocity import VelocityLaw
+
+__all__ = [
+    "AccelerationLaw",
+    "ControlLaw",
+    "ControlOutput",
+    "DampNullMotion",
+    "FixedReference",
+    "Gains",
+    "InvalidGain",
+    "JointQuintic",
+    "JointServo",
+    "MovableTarget",
+    "PathReference",
+    "Switched",
+    "TaskQuintic",
+    "TorqueLaw",
+    "TrackEndEffector",
+    "TrackJointReference",
+    "VelocityLaw",
+]

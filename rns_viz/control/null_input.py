@@ -1,0 +1,111 @@
+"""Null-space inputs P_RNS u for the composite laws (12)/(15)/(16): what the arm does in the RNS.
+
+Each returns the joint acceleration P u (rad/s^2), which by Eq. (14) never reaches the base.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from rns_viz.control.common import Coupling
+from rns_viz.control.reference import JointReference
+from rns_viz.model import FsmsModel
+from rns_viz.profiles import quintic
+from rns_viz.rns import damped_pinv
+
+
+@dataclass
+class NullOutput:
+    Pu: np.ndarray  # (n,) rad/s^2
+    sigma_jbar: float = float("nan")
+    theta_ref: np.ndarray | None = None
+    ee_ref: np.ndarray | None = None
+
+
+class NullInput(Protocol):
+    def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput: ...
+
+
+@dataclass
+class DampNullMotion:
+    """u = -G_m theta': with the law's own -G_m (E - P) theta' this is the paper's -G_m theta' (Fig. 3)."""
+
+    g_m: float  # 1/s
+
+    def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
+        return NullOutput(-self.g_m * (cp.P @ cp.thetadot))
+
+
+@dataclass
+class TrackJointReference:
+    """u = theta_r'' + k_d (theta_r' - theta') + k_p (theta_r - theta), projected into the RNS."""
+
+    reference: JointReference
+    k_p: float  # 1/s^2
+    k_d: float  # 1/s
+
+    def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
+        theta_r, thetadot_r, thetaddot_r = self.reference(t)
+        u = thetaddot_r + self.k_d * (thetadot_r - cp.thetadot) + self.k_p * (theta_r - cp.theta)
+        return NullOutput(cp.P @ u, theta_ref=theta_r)
+
+
+class TaskReference(Protocol):
+    """x_e^d(t), its velocity and acceleration in the base frame (task rows only), SI units."""
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@dataclass
+class TrackEndEffector:
+    """Reactionless end-effector tracking, Eq. (24):
+
+    P u = J-bar^+ [x_d'' + G_d e' + G_p e - J' theta' + J H_bm^+ H_bm' theta'],  e = x_d - x_e.
+    J-bar = J P_RNS is inverted with the damped inverse; its smallest singular value is reported.
+    """
+
+    model: FsmsModel
+    target: TaskReference
+    G_p: float  # 1/s^2
+    G_d: float  # 1/s
+    threshold: float = 1e-2  # sigma_min of J-bar (m/rad) below which damping starts
+
+    def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
+        J, Jdot_thetadot, ee = self.model.ee_kinematics(q, cp.thetadot)
+        x_d, xdot_d, xddot_d = self.target(t)
+        p = len(x_d)
+        e = x_d - ee[self.model.task_rows][:p]
+        edot = xdot_d - J @ cp.thetadot
+        J_bar = J @ cp.P
+        inv = damped_pinv(J_bar, self.threshold, self.threshold)
+        rhs = xddot_d + self.G_d * edot + self.G_p * e - Jdot_thetadot + J @ (cp.H_bm_pinv @ cp.hbm_dot_thetadot)
+        return NullOutput(inv.inverse @ rhs, sigma_jbar=inv.sigma_min, ee_ref=x_d)
+
+
+@dataclass(frozen=True)
+class TaskQuintic:
+    """Straight-line end-effector motion from ``start`` to ``end``, quintic in time (Fig. 4)."""
+
+    start: np.ndarray
+    end: np.ndarray
+    duration: float  # s
+    t0: float = 0.0  # s
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s, ds, dds = quintic((t - self.t0) / self.duration)
+        d = self.end - self.start
+        return self.start + s * d, ds / self.duration * d, dds / self.duration**2 * d
+
+
+@dataclass
+class MovableTarget:
+    """A target the operator moves (the app's drag handle): fixed point, zero rates."""
+
+    position: np.ndarray
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        zero = np.zeros_like(self.position)
+        return self.position.copy(), zero, zero

@@ -1,0 +1,146 @@
+"""Joint-space references: fixed, quintic point to point, and reactionless paths (Eq. 30's integral)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+import pinocchio as pin
+
+from rns_viz.model import FsmsModel
+from rns_viz.profiles import quintic
+from rns_viz.rns import null_vector
+
+
+class JointReference(Protocol):
+    """theta_ref(t), theta_ref'(t), theta_ref''(t), rad and its rates."""
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@dataclass(frozen=True)
+class FixedReference:
+    """A configuration to hold (Sec. VII-D-1: the integral replaced by fixed joint angles)."""
+
+    theta: np.ndarray
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        zero = np.zeros_like(self.theta)
+        return self.theta, zero, zero
+
+
+@dataclass(frozen=True)
+class JointQuintic:
+    """Point-to-point joint motion from ``start`` to ``end`` along a straight line, quintic in time."""
+
+    start: np.ndarray
+    end: np.ndarray
+    duration: float  # s
+    t0: float = 0.0  # s
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s, ds, dds = quintic((t - self.t0) / self.duration)
+        d = self.end - self.start
+        return self.start + s * d, ds / self.duration * d, dds / self.duration**2 * d
+
+
+class PathReference:
+    """theta_ref' = n(theta_ref) u-bar(t): the reactionless reference path of Eq. (30).
+
+    n is the null-space vector of S H_bm (Eq. 27), unnormalised, from pinocchio. The path is
+    integrated with RK4 in steps of at most ``max_step`` as time advances; asking for an earlier
+    time restarts from ``theta0``. Queries must come in non-decreasing time between restarts.
+    """
+
+    def __init__(
+        self,
+        model: FsmsModel,
+        theta0: np.ndarray,
+        ubar: Callable[[float], tuple[float, float]],
+        max_step: float = 1e-3,
+        t0: float = 0.0,
+    ) -> None:
+        if model.n - len(model.selected) != 1:
+            raise ValueError(f"{model.name}: a reactionless reference path needs a 1-D RNS")
+        self.model = model
+        self.data = model.pin_model.createData()
+        self.theta0 = np.asarray(theta0, dtype=float).copy()
+        self.ubar = ubar
+        self.max_step = max_step
+        self.t0 = t0
+        self._q = np.zeros(model.nv)
+        self.restart()
+
+    def restart(self, theta0: np.ndarray | None = None, t0: float | None = None) -> None:
+        if theta0 is not None:
+            self.theta0 = np.asarray(theta0, dtype=float).copy()
+        if t0 is not None:
+            self.t0 = t0
+        self._t = self.t0
+        self._theta = self.theta0.copy()
+
+    def n(self, theta: np.ndarray) -> np.ndarray:
+        """Null-space vector n(theta) (Eq. 27 generalised), kg m."""
+        m = self.model.m
+        self._q[m:] = theta
+        return null_vector(pin.crba(self.model.pin_model, self.data, self._q)[self.model.selected, m:])
+
+    def _advance(self, t: float) -> None:
+        if t < self._t - 1e-12:
+            self.restart()
+        while self._t < t - 1e-12:
+            h = min(self.max_step, t - self._t)
+            t_, th = self._t, self._theta
+            k1 = self.n(th) * self.ubar(t_)[0]
+            k2 = self.n(th + 0.5 * h * k1) * self.ubar(t_ + 0.5 * h)[0]
+            k3 = self.n(th + 0.5 * h * k2) * self.ubar(t_ + 0.5 * h)[0]
+            k4 = self.n(th + h * k3) * self.ubar(t_ + h)[0]
+            self._theta = th + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            self._t = t_ + h
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        self._advance(t)
+        theta = self._theta.copy()
+        u, du = self.ubar(t)
+        n = self.n(theta)
+        eps = 1e-6
+        dn_along_n = (self.n(theta + eps * n) - self.n(theta - eps * n)) / (2 * eps)  # (Dn) n
+        return theta, n * u, dn_along_n * u * u + n * du
+
+
+def path_integral_to(
+    model: FsmsModel,
+    theta0: np.ndarray,
+    crossing: Callable[[np.ndarray], float],
+    step: float = 1e-2,
+    limit: float = 1e4,
+    tol: float = 1e-12,
+) -> tuple[float, np.ndarray]:
+    """sigma and theta where the path theta' = n(theta) from theta0 first makes ``crossing`` change sign.
+
+    Integrates in sigma (the integral of u-bar dt) with steps ``step``, then bisects the last
+    step. Gives the total of u-bar that carries a reference to a chosen point of its path.
+    """
+    ref = PathReference(model, theta0, lambda _t: (1.0, 0.0), max_step=step)
+    sigma, prev = 0.0, np.asarray(theta0, dtype=float)
+    while sigma < limit:
+        theta = ref(sigma + step)[0]
+        if crossing(prev) * crossing(theta) <= 0 and sigma > 0:
+            break
+        sigma, prev = sigma + step, theta
+    else:
+        raise ValueError("the reactionless path did not reach the requested point")
+    lo, hi = 0.0, step
+    fine = PathReference(model, prev, lambda _t: (1.0, 0.0), max_step=step / 100)
+    sign = np.sign(crossing(prev))
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        fine.restart()
+        if np.sign(crossing(fine(mid)[0])) == sign:
+            lo = mid
+        else:
+            hi = mid
+    fine.restart()
+    return sigma + hi, fine(hi)[0]

@@ -1,0 +1,63 @@
+"""Velocity-command law for TREP, Eq. (30), behind a joint velocity servo.
+
+theta'_cmd = H_bm^+ H_b g_b x_b + g_m (theta_ref - theta)       [+ theta_ref' if feedforward]
+
+Read with the base deflection x_b, not its rate: integrating (29) with constant H_bm^+ turns
+H_bm^+ m_b g_b x_b' into H_bm^+ m_b g_b x_b (DESIGN.md section 3); only this form has
+consistent units and damps. m_b is H_b, the base inertia of Eq. (1). theta_ref is the path
+integral of n u-bar (PathReference), a fixed configuration, or any joint reference.
+
+The servo: the motor drivers of TREP take velocity commands; we model them as a velocity loop
+of bandwidth w_s, theta'' = w_s (theta'_cmd - theta'), realised by resolved acceleration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rns_viz.control.common import ControlOutput, Coupling, CouplingEvaluator, Gains, realize_acceleration
+from rns_viz.control.reference import JointReference
+from rns_viz.model import FsmsModel
+
+
+class VelocityLaw:
+    """Eq. (30); ``suppress=False`` sets the g_b term to zero: the joints just hold/track theta_ref."""
+
+    def __init__(
+        self,
+        model: FsmsModel,
+        gains: Gains,
+        reference: JointReference,
+        suppress: bool = True,
+        feedforward: bool = False,
+        suppress_after: float = float("-inf"),
+    ) -> None:
+        self.model = model
+        self.gains = gains
+        self.reference = reference
+        self.suppress = suppress
+        self.suppress_after = suppress_after  # s: suppression starts here (Fig. 3)
+        self.feedforward = feedforward
+        self.coupling = CouplingEvaluator(model)
+
+    def command(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, Coupling]:
+        """theta'_cmd of Eq. (30), theta_ref and the coupling it used."""
+        cp = self.coupling(q, v)
+        theta_r, thetadot_r, _ = self.reference(t)
+        g_b = self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
+        cmd = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.x_b)) + self.gains.g_m * (theta_r - cp.theta)
+        if self.feedforward:
+            cmd = cmd + thetadot_r
+        return cmd, theta_r, cp
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
+        cmd, theta_r, cp = self.command(t, q, v)
+        thetaddot = self.gains.servo_bandwidth * (cmd - cp.thetadot)
+        tau = realize_acceleration(self.model, cp, q, v, thetaddot)
+        return ControlOutput(
+            tau=tau,
+            coupling_momentum=cp.H_bm @ cp.thetadot,
+            sigma_hbm=cp.sigma,
+            theta_ref=theta_r,
+            extra={f"thetadot_cmd_{i + 1}": float(c) for i, c in enumerate(cmd)},
+        )

@@ -1,0 +1,92 @@
+"""The robot's URDF visuals in viser, posed from pinocchio's forward kinematics.
+
+Meshes come from yourdfpy (the same URDF pinocchio reads). The viser node tree mirrors the
+kinematic tree: base joints are world-posed nodes (the last one is ``base_name``, so overlays given
+in the base frame can hang under it), each arm joint is a child node of its parent joint posed by
+pinocchio's ``liMi``. Fixed links (the end effector) have their meshes moved into the parent
+joint's node, so they cost nothing per frame. A pose is only sent when it changed: a planar arm
+sends one orientation per arm joint and one base position per frame. (Each viser pose setter costs
+~50 us because it runs ``np.allclose``; ``ViserUrdf.update_cfg`` walks yourdfpy's scene graph.)
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+import pinocchio as pin
+import viser
+import yourdfpy
+
+from rns_viz.model import FsmsModel
+
+
+class RobotMeshes:
+    """One frame node per pinocchio joint, the URDF visuals under the joint that carries them."""
+
+    def __init__(
+        self, server: viser.ViserServer, model: FsmsModel, base_name: str = "/base", root: str = "/robot"
+    ) -> None:
+        path = model.spec.urdf_path
+        urdf = yourdfpy.URDF.load(
+            str(path),
+            build_scene_graph=True,
+            load_meshes=True,
+            filename_handler=partial(yourdfpy.filename_handler_magic, dir=path.parent),
+        )
+        pm = model.pin_model
+        self.model = model
+        self.data = pm.createData()  # own data: the simulation thread may be using model.data
+        self.node_names = [root] + [""] * (pm.njoints - 1)
+        for j in range(1, pm.njoints):
+            link = urdf.joint_map[pm.names[j]].child
+            if j < model.m:
+                self.node_names[j] = f"{root}/{link}"
+            elif j == model.m:
+                self.node_names[j] = base_name
+            else:
+                self.node_names[j] = f"{self.node_names[pm.parents[j]]}/{link}"
+        server.scene.add_frame(root, show_axes=False)
+        self.frames = [server.scene.add_frame(name, show_axes=False) for name in self.node_names[1:]]
+        self._world_posed = model.m  # joints 1..m are posed in the world, the rest relative to parents
+        self._last: list[tuple[tuple[float, ...], tuple[float, ...]] | None] = [None] * len(self.frames)
+        self.meshes: list[viser.MeshHandle] = []
+        scene = urdf.scene
+        for geom_name, mesh in scene.geometry.items():
+            link = scene.graph.transforms.parents[geom_name]
+            frame = pm.frames[pm.getFrameId(link)]
+            local = mesh.copy()
+            local.apply_transform(frame.placement.homogeneous @ urdf.get_transform(geom_name, link))
+            node = self.node_names[frame.parentJoint]
+            self.meshes.append(server.scene.add_mesh_trimesh(f"{node}/{link}_{geom_name}", local))
+
+    def pose(self, q: np.ndarray) -> None:
+        """Forward kinematics at ``q`` (pinocchio order); send the joint poses that changed."""
+        pm, data = self.model.pin_model, self.data
+        pin.forwardKinematics(pm, data, q)
+        for i, handle in enumerate(self.frames):
+            j = i + 1
+            M = data.oMi[j] if j <= self._world_posed else data.liMi[j]
+            position = tuple(M.translation.tolist())
+            quat = pin.Quaternion(M.rotation)
+            wxyz = (quat.w, quat.x, quat.y, quat.z)
+            last = self._last[i]
+            if last is None or last[0] != position:
+                handle.position = position
+            if last is None or last[1] != wxyz:
+                handle.wxyz = wxyz
+            self._last[i] = (position, wxyz)
+
+    def base_placement(self) -> pin.SE3:
+        """World placement of the last base joint after :meth:`pose` (the base frame)."""
+        return self.data.oMi[self.model.m]
+
+    @property
+    def base_node(self) -> viser.FrameHandle:
+        """The node that follows the last base joint; children are in the base frame."""
+        return self.frames[self.model.m - 1]
+
+    def ee_position(self, offset: np.ndarray | None = None) -> np.ndarray:
+        """World position of the end effector (plus ``offset`` in the base frame) after :meth:`pose`, m."""
+        ee = pin.updateFramePlacement(self.model.pin_model, self.data, self.model.ee_frame_id).translation
+        return ee if offset is None else ee + self.base_placement().rotation @ offset

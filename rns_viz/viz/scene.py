@@ -1,0 +1,254 @@
+"""The FSMS scene in viser: robot, elastic base, end-effector trail, reaction arrow and overlays.
+
+``FsmsScene(server, model)`` builds everything once; ``update(q, exaggeration)`` poses it for a
+configuration q = (x_b, theta) inside one ``server.atomic()`` block. Base deflections are drawn
+multiplied by ``exaggeration`` (the arm rides on the exaggerated base too). Overlays given in the
+base frame (path family, reachable set, target, reaction arrow) hang under the ``/base`` node,
+which follows the drawn base, so the end effector stays on its drawn path while the base moves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Literal
+
+import numpy as np
+import viser
+
+from rns_viz.model import FsmsModel
+from rns_viz.paths import ReactionlessPath
+from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.geometry import Trail, path_colours, path_family_segments, polyline_segments
+from rns_viz.viz.robot import RobotMeshes
+from rns_viz.viz.style import CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
+
+PATH_COLOUR = (0.62, 0.74, 0.88)  # other reactionless paths, RGB in [0, 1]
+PATH_HIGHLIGHT = (0.90, 0.05, 0.30)  # the current path
+TRAIL_COLOUR = (0.20, 0.65, 0.30)
+FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
+TARGET_COLOUR = (30, 170, 90)
+REACH_COLOUR = (196, 182, 236)  # pale, under the arm
+
+
+class FsmsScene:
+    """Everything the FSMS app draws. Node names are class constants so tests can find them."""
+
+    BASE = "/base"
+    PATHS = "/base/paths"
+    REACHABLE = "/base/reachable"
+    TARGET = "/base/target"
+    FORCE = "/base/reaction"
+    FORCE_LABEL = "/base/reaction/label"
+    TRAIL = "/trail"  # world-frame trail; a base-frame trail is BASE_TRAIL
+    BASE_TRAIL = "/base/trail"
+    GRID = "/grid"
+    ROBOT = "/robot"
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        model: FsmsModel,
+        style: SceneStyle | None = None,
+        trail_frame: Literal["world", "base"] = "world",
+    ) -> None:
+        """Build the scene. ``trail_frame="world"`` shows the drawn base's shaking in the trail;
+        ``"base"`` traces the end effector relative to the base (the frame reactionless paths live in).
+        """
+        self.server = server
+        self.model = model
+        self.style = style or style_for(model)
+        st = self.style
+        scene = server.scene
+        scene.configure_environment_map(None)  # the default HDRI freezes software-rendered pages
+        scene.configure_default_lights(enabled=True, cast_shadow=False)  # a key light from above
+        scene.add_light_ambient("/lights/ambient", intensity=0.8)
+        # A directional light shines from its node position towards the world origin.
+        scene.add_light_directional("/lights/fill", intensity=1.0, position=(1.0, -2.0, 1.5))
+        self.grid = scene.add_grid(
+            self.GRID,
+            width=st.grid_size,
+            height=st.grid_size,
+            cell_size=st.grid_cell,
+            section_size=5 * st.grid_cell,
+            position=(0.0, 0.0, st.grid_z),
+        )
+        lift = (0.0, 0.0, st.overlay_z)  # base-frame overlays sit at the drawn end effector's height
+        self._lift = np.array(lift)
+        self._trail_lift = self._lift + np.array([0.0, 0.0, st.line_thickness])  # drawn over the path it follows
+        self.robot = RobotMeshes(server, model, base_name=self.BASE, root=self.ROBOT)
+        self.base_node = self.robot.base_node
+        self.base_drawing = _make_base_drawing(server, model, st.base)
+        self.paths = scene.add_line_segments(
+            self.PATHS, np.zeros((1, 2, 3)), PATH_COLOUR, thickness=st.line_thickness, position=lift, visible=False
+        )
+        self._path_owners = np.zeros(0, dtype=int)
+        self.current_path: int | None = None
+        self.reachable = scene.add_point_cloud(
+            self.REACHABLE,
+            np.zeros((1, 3)),
+            REACH_COLOUR,
+            point_size=0.3 * st.marker_radius,
+            point_shape="circle",
+            precision="float32",
+            position=(0.0, 0.0, st.overlay_z - st.marker_radius),  # just below the arm
+            visible=False,
+        )
+        self.target = scene.add_icosphere(
+            self.TARGET, radius=st.marker_radius, color=TARGET_COLOUR, opacity=0.7, visible=False
+        )
+        self.force = scene.add_arrows(
+            self.FORCE,
+            np.zeros((1, 2, 3)),
+            FORCE_COLOUR,
+            shaft_radius=0.25 * st.marker_radius,
+            head_radius=0.6 * st.marker_radius,
+            head_length=1.5 * st.marker_radius,
+            visible=False,
+        )
+        self.force_label = scene.add_label(self.FORCE_LABEL, "", anchor="top-center", visible=False)
+        self._force = 0.0
+        self._force_axis = model.base_axes()[0] if model.base_is_translational else np.array([1.0, 0.0, 0.0])
+        self._force_origin = np.asarray(st.force_origin, dtype=float)
+        self.trail = Trail(st.trail_capacity, st.trail_step or 0.25 * st.marker_radius, st.trail_jump)
+        self.trail_in_base = trail_frame == "base"
+        self.trail_node = scene.add_line_segments(
+            self.BASE_TRAIL if self.trail_in_base else self.TRAIL,
+            np.zeros((1, 2, 3)),
+            TRAIL_COLOUR,
+            thickness=1.5 * st.line_thickness,
+            visible=False,
+        )
+        self._add_labels()
+        self.set_initial_camera()
+        self.q = model.q(model.spec.default_configuration)
+        self.exaggeration = 1.0
+        self.update(self.q, 1.0)
+
+    # -- per frame -----------------------------------------------------------------------------
+    def update(self, q: np.ndarray, exaggeration: float = 1.0, trail: bool = True) -> None:
+        """Pose robot, base drawing and base-frame overlays for q = (x_b, theta); base drawn x exaggeration."""
+        m = self.model.m
+        q_draw = np.array(q, dtype=float)
+        if q_draw.shape != (self.model.nv,):
+            raise ValueError(f"q must be (x_b, theta) with shape ({self.model.nv},), got {q_draw.shape}")
+        q_draw[:m] *= exaggeration
+        self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
+        with self.server.atomic():
+            self.robot.pose(q_draw)
+            if self.base_drawing is not None:
+                self.base_drawing.update(self.robot.base_placement().translation)
+            if trail and self.trail.push(self._trail_point()):
+                self._draw_trail()
+
+    def set_reaction_force(self, f: float) -> None:
+        """Arrow along the base axis at the base: ``f`` in N (the base reaction, paper's F_b)."""
+        if f == self._force:
+            return
+        self._force = f
+        st = self.style
+        length = float(np.clip(f * st.force_scale, -st.force_arrow_max, st.force_arrow_max))
+        show = abs(length) > 0.5 * self.force.head_length
+        with self.server.atomic():
+            self.force.visible = show
+            self.force_label.visible = show
+            if show:
+                tip = self._force_origin + length * self._force_axis
+                self.force.points = np.stack([self._force_origin, tip])[None]
+                self.force_label.position = tip
+                self.force_label.text = f"F = {f:.3g} N"
+
+    # -- overlays ------------------------------------------------------------------------------
+    def set_path_family(
+        self, paths: Sequence[ReactionlessPath] | Sequence[np.ndarray], current_index: int | None
+    ) -> None:
+        """Draw all paths (base-frame end-effector curves) as one line-segment node; highlight one."""
+        curves = [p.ee if isinstance(p, ReactionlessPath) else np.asarray(p) for p in paths]
+        if current_index is not None and not 0 <= current_index < len(curves):
+            raise IndexError(f"current_index {current_index} is not one of the {len(curves)} paths")
+        segs, colours, owners = path_family_segments(
+            curves, current_index, self.style.path_points, PATH_COLOUR, PATH_HIGHLIGHT
+        )
+        self._path_owners, self.current_path = owners, current_index
+        with self.server.atomic():
+            if len(segs):
+                self.paths.points = segs
+                self.paths.colors = colours
+            self.paths.visible = bool(len(segs))
+
+    def set_current_path(self, current_index: int | None) -> None:
+        """Re-colour the drawn family only (cheap); the current path is not moved to the top."""
+        if current_index == self.current_path or not len(self._path_owners):
+            return
+        self.current_path = current_index
+        self.paths.colors = path_colours(self._path_owners, current_index, PATH_COLOUR, PATH_HIGHLIGHT)
+
+    def set_reachable_set(self, points: np.ndarray | None) -> None:
+        """Base-frame end-effector points (N, 3) reachable without reaction (the 3R), or None to hide."""
+        if points is None or len(points) == 0:
+            self.reachable.visible = False
+            return
+        with self.server.atomic():
+            self.reachable.points = np.asarray(points, dtype=np.float32)
+            self.reachable.colors = np.array(REACH_COLOUR, dtype=np.uint8)
+            self.reachable.visible = True
+
+    def set_target(self, position: np.ndarray | None) -> None:
+        """End-effector target marker at a base-frame position (m), or None to hide it."""
+        if position is None:
+            self.target.visible = False
+            return
+        with self.server.atomic():
+            self.target.position = np.asarray(position, dtype=float) + self._lift
+            self.target.visible = True
+
+    def clear_trail(self) -> None:
+        """Forget the end-effector trail (after a reset or a jump to a new configuration)."""
+        self.trail.clear()
+        self.trail_node.visible = False
+
+    # -- camera --------------------------------------------------------------------------------
+    def set_initial_camera(self, clients: bool = True) -> None:
+        """The model's camera for new clients and Reset View; ``clients`` also moves connected ones."""
+        st = self.style
+        cam = self.server.initial_camera
+        cam.position = st.camera_position
+        cam.look_at = st.camera_look_at
+        cam.near = 0.005 * float(np.linalg.norm(np.subtract(st.camera_position, st.camera_look_at)))
+        if clients:
+            for client in self.server.get_clients().values():
+                client.camera.position = st.camera_position
+                client.camera.look_at = st.camera_look_at
+
+    # -- internals -----------------------------------------------------------------------------
+    def _trail_point(self) -> np.ndarray:
+        ee = self.robot.ee_position(self._trail_lift)  # world, m
+        if not self.trail_in_base:
+            return ee
+        base = self.robot.base_placement()
+        return base.rotation.T @ (ee - base.translation)
+
+    def _draw_trail(self) -> None:
+        pts = self.trail.points()
+        if len(pts) < 2:
+            return
+        self.trail_node.points = polyline_segments(pts)
+        self.trail_node.visible = True
+
+    def _add_labels(self) -> None:
+        scene, st = self.server.scene, self.style
+        scene.add_label("/base/label", "base x_b", position=st.base_label, anchor="bottom-center")
+        if isinstance(st.base, DoubleBeamStyle):
+            scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
+        elif isinstance(st.base, CartSpringStyle):
+            middle = 0.5 * (st.base.wall_x + st.base.attach[0])
+            scene.add_label("/spring/label", "k_b", position=(middle, 0.0, 0.05))
+
+
+def _make_base_drawing(
+    server: viser.ViserServer, model: FsmsModel, style: DoubleBeamStyle | CartSpringStyle | None
+) -> DoubleBeamDrawing | CartSpringDrawing | None:
+    if isinstance(style, DoubleBeamStyle):
+        return DoubleBeamDrawing(server, model, style)
+    if isinstance(style, CartSpringStyle):
+        return CartSpringDrawing(server, model, style)
+    return None

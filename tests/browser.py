@@ -1,0 +1,133 @@
+"""Real-browser helpers: Debian chromium driven by Playwright against a local viser server.
+
+Recipe (DESIGN.md §8): ``/usr/bin/chromium`` (apt), never ``playwright install``; headless with
+software rendering (SwiftShader), a fresh user-data-dir per browser. Scene nodes are read from
+the client's ``window.__viserMutable.nodeRefFromName`` (viser/client/src/App.tsx exposes it).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import viser
+from playwright.sync_api import Page, sync_playwright
+
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+ARTIFACTS = Path(__file__).resolve().parent.parent / "artifacts"
+SKIP_REASON = f"real-browser test needs Debian chromium at {CHROMIUM} (apt-get install chromium)"
+
+
+def chromium_available() -> bool:
+    return CHROMIUM.is_file()
+
+
+def wait_until(condition: Callable[[], object], timeout: float, what: str, poll: float = 0.05) -> None:
+    """Poll ``condition`` until it is truthy; AssertionError naming ``what`` after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        time.sleep(poll)
+
+
+@contextmanager
+def local_server() -> Iterator[viser.ViserServer]:
+    """A viser server on a free port bound to 127.0.0.1, stopped afterwards."""
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        yield server
+    finally:
+        server.stop()
+
+
+@contextmanager
+def browser_page(
+    server: viser.ViserServer, width: int = 1280, height: int = 800, timeout: float = 30.0
+) -> Iterator[Page]:
+    """A Playwright page showing ``server``, yielded once the client has connected.
+
+    ``chromium.launch`` gives every browser a fresh temporary profile (user-data-dir) of its own.
+    """
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+        try:
+            page = browser.new_page(viewport={"width": width, "height": height})
+            page.goto(f"http://127.0.0.1:{server.get_port()}/", timeout=timeout * 1000)
+            wait_until(lambda: len(server.get_clients()) > 0, timeout, "the browser to connect to viser")
+            yield page
+        finally:
+            browser.close()
+
+
+def scene_node_names(page: Page) -> set[str]:
+    """Names of the scene nodes the client has mounted."""
+    return set(page.evaluate("() => Object.keys(window.__viserMutable?.nodeRefFromName ?? {})"))
+
+
+def local_position(page: Page, name: str) -> list[float] | None:
+    """Position of a mounted node relative to its parent node, in viser's coordinates, or None.
+
+    (``matrixWorld`` would include the client's z-up root rotation; the local position does not.)
+    """
+    return page.evaluate(
+        """(name) => {
+            const obj = window.__viserMutable?.nodeRefFromName?.[name];
+            return obj ? [obj.position.x, obj.position.y, obj.position.z] : null;
+        }""",
+        name,
+    )
+
+
+def dismiss_notifications(page: Page) -> None:
+    """Close the client's toasts (e.g. "Software WebGL rendering detected") before a screenshot."""
+    buttons = page.locator(".mantine-Notification-closeButton")
+    for k in reversed(range(buttons.count())):
+        buttons.nth(k).click()
+
+
+def wait_for_nodes(page: Page, names: set[str], timeout: float = 30.0) -> None:
+    """Wait until every name in ``names`` is mounted in the page's scene."""
+    missing: set[str] = set(names)
+
+    def ready() -> bool:
+        missing.clear()
+        missing.update(names - scene_node_names(page))
+        return not missing
+
+    try:
+        wait_until(ready, timeout, "scene nodes")
+    except AssertionError:
+        raise AssertionError(f"scene nodes never appeared in the browser: {sorted(missing)}") from None
+
+
+def wait_for_frames(page: Page, frames: int = 30) -> None:
+    """Let the page render ``frames`` animation frames (software rendering is slow)."""
+    page.evaluate(
+        """(n) => new Promise((done) => {
+            let k = 0;
+            const step = () => (++k >= n ? done(null) : requestAnimationFrame(step));
+            requestAnimationFrame(step);
+        })""",
+        frames,
+    )
+
+
+def screenshot(page: Page, name: str) -> Path:
+    """Save a PNG of the page to ``artifacts/<name>.png`` and return its path."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    path = ARTIFACTS / f"{name}.png"
+    page.screenshot(path=str(path))
+    return path

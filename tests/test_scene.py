@@ -1,0 +1,190 @@
+"""Headless tests of the viser scene layer: nodes, poses and geometry, no browser."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+import viser
+
+from rns_viz.model import FsmsModel
+from rns_viz.paths import path_family
+from rns_viz.viz import FsmsScene
+from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.geometry import Trail, guided_cantilever, path_family_segments, zigzag
+from rns_viz.viz.scene import PATH_HIGHLIGHT
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[viser.ViserServer]:
+    srv = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    yield srv
+    srv.stop()
+
+
+@pytest.fixture
+def trep_scene(server: viser.ViserServer, trep: FsmsModel) -> FsmsScene:
+    server.scene.reset()
+    return FsmsScene(server, trep)
+
+
+@pytest.fixture
+def planar_scene(server: viser.ViserServer, planar3r: FsmsModel) -> FsmsScene:
+    server.scene.reset()
+    return FsmsScene(server, planar3r)
+
+
+@pytest.mark.parametrize("name", ["trep", "planar3r"])
+def test_scene_builds_with_its_nodes(server: viser.ViserServer, name: str) -> None:
+    server.scene.reset()
+    model = FsmsModel.from_name(name)
+    scene = FsmsScene(server, model)
+    base_node = "/beam/plates" if name == "trep" else "/spring/coil"
+    for node in (FsmsScene.BASE, FsmsScene.PATHS, FsmsScene.TRAIL, FsmsScene.FORCE, FsmsScene.GRID, base_node):
+        assert server.scene.get_handle_by_name(node) is not None, node
+    assert len(scene.robot.meshes) >= model.n  # every arm link has a visual
+    assert np.allclose(server.initial_camera.look_at, scene.style.camera_look_at)
+
+
+def test_update_bends_the_beam_by_exaggerated_deflection(trep_scene: FsmsScene, trep: FsmsModel) -> None:
+    x_b, exaggeration = 0.003, 20.0
+    trep_scene.update(trep.q(trep.spec.default_configuration, [x_b]), exaggeration)
+    drawn = exaggeration * x_b
+    assert np.allclose(trep_scene.base_node.position, [drawn, 0.5, 0.0])
+    beam = trep_scene.base_drawing
+    assert isinstance(beam, DoubleBeamDrawing)
+    lines = beam.centrelines(beam.x_b)  # (plates, stations, 3)
+    assert np.allclose(lines[:, -1, 0], [drawn - 0.05, drawn + 0.05])  # guided tip moves with the base
+    assert np.allclose(lines[:, 0, 0], [-0.05, 0.05])  # clamped root stays
+    mid = beam.style.stations // 2
+    assert np.allclose(lines[:, mid, 0] - [-0.05, 0.05], 0.5 * drawn)  # u(L/2) = x_b (3/4 - 2/8)
+    verts = np.asarray(beam.mesh.vertices).reshape(2, beam.style.stations, 2, 3)
+    assert np.allclose(verts[:, -1, :, 0], np.array([[drawn - 0.05] * 2, [drawn + 0.05] * 2]), atol=1e-6)
+
+
+def test_update_poses_the_arm_from_pinocchio(trep_scene: FsmsScene, trep: FsmsModel) -> None:
+    theta = np.array([0.4, -1.1])
+    trep_scene.update(trep.q(theta, [0.002]), 10.0)
+    ee = trep_scene.robot.ee_position()
+    assert np.allclose(ee, trep.ee_position(theta) + np.array([0.02, 0.5, 0.0]))
+    link1 = trep_scene.server.scene.get_handle_by_name("/base/link1")
+    assert link1 is not None
+    assert np.allclose(abs(link1.wxyz[0]), np.cos(0.2)) and np.allclose(abs(link1.wxyz[3]), np.sin(0.2))
+
+
+def test_update_rejects_a_wrong_configuration(trep_scene: FsmsScene) -> None:
+    with pytest.raises(ValueError, match="shape"):
+        trep_scene.update(np.zeros(2), 1.0)
+
+
+def test_cart_and_spring_follow_the_base(planar_scene: FsmsScene, planar3r: FsmsModel) -> None:
+    planar_scene.update(planar3r.q(planar3r.spec.default_configuration, [0.1]), 3.0)
+    assert np.allclose(planar_scene.base_node.position, [0.3, 0.0, 0.0])
+    spring = planar_scene.base_drawing
+    assert isinstance(spring, CartSpringDrawing)
+    points = np.asarray(spring.spring.points)
+    assert np.allclose(points[0, 0], spring.anchor, atol=1e-6)
+    assert np.allclose(points[-1, 1], [0.3 + spring.attach[0], 0.0, spring.attach[2]], atol=1e-6)
+
+
+def test_path_family_is_one_node_with_the_current_path_highlighted(trep_scene: FsmsScene, trep: FsmsModel) -> None:
+    paths = path_family(trep, 12)
+    trep_scene.set_path_family(paths, 3)
+    points, colours = np.asarray(trep_scene.paths.points), np.asarray(trep_scene.paths.colors)
+    per_path = [min(len(p.ee), trep_scene.style.path_points) - 1 for p in paths]
+    assert points.shape == (sum(per_path), 2, 3)
+    assert colours.shape == points.shape
+    highlight = (np.array(PATH_HIGHLIGHT) * 255).astype(np.uint8)
+    is_current = np.all(colours == highlight, axis=(1, 2))
+    assert is_current.sum() == per_path[3] and np.all(is_current[-per_path[3] :])  # drawn last, on top
+    assert np.allclose(points[is_current][:, 0], paths[3].ee[:-1], atol=1e-6)
+    trep_scene.set_current_path(5)  # recolour only
+    is_current = np.all(np.asarray(trep_scene.paths.colors) == highlight, axis=(1, 2))
+    assert is_current.sum() == per_path[5]
+    assert np.allclose(points[is_current][:, 0], paths[5].ee[:-1], atol=1e-6)
+    with pytest.raises(IndexError):
+        trep_scene.set_path_family(paths, len(paths))
+
+
+def test_long_paths_are_thinned() -> None:
+    curve = np.column_stack([np.linspace(0, 1, 1000), np.zeros(1000), np.zeros(1000)])
+    segs, colours, owners = path_family_segments([curve, curve[:10]], None, 100, (0.5, 0.5, 0.5), (1, 0, 0))
+    assert len(segs) == 99 + 9 and np.all(owners[:99] == 0)
+    assert np.allclose(segs[0, 0], curve[0]) and np.allclose(segs[98, 1], curve[-1])
+    assert np.allclose(colours, 0.5)
+
+
+def test_reachable_set_target_and_force(planar_scene: FsmsScene) -> None:
+    points = np.random.default_rng(0).uniform(-2, 2, (500, 3))
+    planar_scene.set_reachable_set(points)
+    assert planar_scene.reachable.visible and np.asarray(planar_scene.reachable.points).shape == (500, 3)
+    planar_scene.set_reachable_set(None)
+    assert not planar_scene.reachable.visible
+    planar_scene.set_target(np.array([1.0, 0.5, 0.0]))
+    assert planar_scene.target.visible and np.allclose(planar_scene.target.position, [1.0, 0.5, 0.0])
+    st = planar_scene.style
+    planar_scene.set_reaction_force(40.0)
+    arrow = np.asarray(planar_scene.force.points)[0]
+    assert planar_scene.force.visible and np.isclose(arrow[1, 0] - arrow[0, 0], 40.0 * st.force_scale)
+    planar_scene.set_reaction_force(-1e6)  # clipped, pointing the other way
+    arrow = np.asarray(planar_scene.force.points)[0]
+    assert np.isclose(arrow[1, 0] - arrow[0, 0], -st.force_arrow_max)
+    planar_scene.set_reaction_force(0.0)
+    assert not planar_scene.force.visible
+
+
+def test_trail_is_bounded_and_restarts_after_a_jump() -> None:
+    trail = Trail(capacity=5, min_step=0.01, max_jump=1.0)
+    for k in range(8):
+        assert trail.push(np.array([0.1 * k, 0.0, 0.0]))
+    assert not trail.push(np.array([0.705, 0.0, 0.0]))  # closer than min_step
+    pts = trail.points()
+    assert len(pts) == 5 and np.allclose(pts[:, 0], [0.3, 0.4, 0.5, 0.6, 0.7])
+    trail.push(np.array([5.0, 0.0, 0.0]))
+    assert len(trail) == 1
+
+
+def test_scene_trail_follows_the_end_effector(trep_scene: FsmsScene, trep: FsmsModel) -> None:
+    trep_scene.clear_trail()
+    for t in np.linspace(0.0, 1.0, 50):
+        trep_scene.update(trep.q([np.pi / 2 + t, 0.0]), 1.0)
+    segs = np.asarray(trep_scene.trail_node.points)
+    assert trep_scene.trail_node.visible and 10 < len(segs) < trep_scene.style.trail_capacity
+    assert np.allclose(np.linalg.norm(segs[:, :, :2] - [0.0, 0.5], axis=-1), 0.2, atol=1e-5)  # a circle arc
+
+
+def test_beam_shape_and_spring_geometry() -> None:
+    xi = np.linspace(0, 1, 101)
+    u = guided_cantilever(xi)
+    assert u[0] == 0 and u[-1] == 1 and np.isclose(u[50], 0.5)
+    h = 1e-6
+    slope = (guided_cantilever(np.array([h, 1.0])) - guided_cantilever(np.array([0.0, 1.0 - h]))) / h
+    assert np.all(np.abs(slope) < 1e-5)  # clamped root, guided tip: no slope at either end
+    pts = zigzag(np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), coils=4, amplitude=0.1)
+    assert np.allclose(pts[0], 0) and np.allclose(pts[-1], [1, 0, 0]) and np.isclose(np.abs(pts[:, 1]).max(), 0.1)
+
+
+def test_update_is_cheap(trep_scene: FsmsScene, trep: FsmsModel) -> None:
+    """DESIGN: 60 Hz leaves 16 ms a frame; the scene's share should stay near 1 ms (bound loose for CI)."""
+    q = trep.q(trep.spec.default_configuration)
+    times = []
+    for k in range(300):
+        q[0], q[1] = 0.003 * np.sin(0.1 * k), 1.0 + 0.01 * k
+        start = time.perf_counter()
+        trep_scene.update(q, 10.0)
+        times.append(time.perf_counter() - start)
+    assert np.median(times) < 5e-3
+
+
+def test_base_frame_trail_ignores_base_motion(server: viser.ViserServer, trep: FsmsModel) -> None:
+    lengths = {}
+    for frame in ("world", "base"):
+        server.scene.reset()
+        scene = FsmsScene(server, trep, trail_frame=frame)
+        for x_b in np.linspace(0.0, 0.004, 20):  # the base moves, the arm does not
+            scene.update(trep.q(trep.spec.default_configuration, [x_b]), 10.0)
+        lengths[frame] = len(scene.trail)
+    assert server.scene.get_handle_by_name(FsmsScene.BASE_TRAIL) is not None
+    assert lengths["world"] > 5 and lengths["base"] == 1
