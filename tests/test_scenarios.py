@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -11,17 +13,20 @@ from rns_viz.scenarios import PLANAR3R_KICK, SCENARIOS, run_scenario
 from rns_viz.sim import ForcePulse, Simulator
 from tests.oracles.mujoco_replay import replay
 
+Runs = Callable[[str], Simulator]
+
 
 @pytest.fixture(scope="module")
-def runs() -> dict:
-    cache: dict = {}
+def runs() -> Runs:
+    """Each preset run once per module, on demand."""
+    cache: dict[str, Simulator] = {}
 
-    def get(name: str):  # noqa: ANN202
+    def get(name: str) -> Simulator:
         if name not in cache:
             cache[name] = run_scenario(name)
         return cache[name]
 
-    return get  # type: ignore[return-value]
+    return get
 
 
 def envelope(t: np.ndarray, x: np.ndarray, start: float, stop: float) -> float:
@@ -44,7 +49,7 @@ def test_all_presets_exist() -> None:
     assert expected <= set(SCENARIOS)
 
 
-def test_fig11_reactionless_path_barely_moves_the_base(runs) -> None:  # noqa: ANN001
+def test_fig11_reactionless_path_barely_moves_the_base(runs: Runs) -> None:
     joint2 = np.abs(runs("fig11-joint2").log.column("xb_1")).max()
     for name in ("fig11-slow", "fig11-fast"):
         log = runs(name).log
@@ -59,7 +64,7 @@ def test_fig11_reactionless_path_barely_moves_the_base(runs) -> None:  # noqa: A
     assert np.abs(runs("fig11-fast").log.column("thetadot_2")).max() > 1.8 * np.abs(a.column("thetadot_2")).max()
 
 
-def test_fig10_suppression(runs) -> None:  # noqa: ANN001
+def test_fig10_suppression(runs: Runs) -> None:
     for name, decays in (("fig10-on", True), ("fig10-off", False)):
         log = runs(name).log
         t, xb = log.column("t"), log.column("xb_1")
@@ -71,7 +76,7 @@ def test_fig10_suppression(runs) -> None:  # noqa: ANN001
             assert min(envelope(t, xb, k, k + 1.0) for k in range(1, 9)) > 0.5 * peak
 
 
-def test_fig12_reactionless_cycling_does_not_disturb_vibration(runs) -> None:  # noqa: ANN001
+def test_fig12_reactionless_cycling_does_not_disturb_vibration(runs: Runs) -> None:
     on, off = runs("fig12-on").log, runs("fig12-off").log
     t = on.column("t")
     kick = 4.0
@@ -127,7 +132,7 @@ def test_fig3_suppression_beats_natural_decay() -> None:
     assert controlled >= 20 * natural
 
 
-def test_fig4_reactionless_tracking(runs) -> None:  # noqa: ANN001
+def test_fig4_reactionless_tracking(runs: Runs) -> None:
     log = runs("fig4").log
     err = np.hypot(log.column("ee_x") - log.column("ee_ref_x"), log.column("ee_y") - log.column("ee_ref_y"))
     assert err[-1] <= 1e-3
@@ -138,7 +143,7 @@ def test_fig4_reactionless_tracking(runs) -> None:  # noqa: ANN001
 
 
 @pytest.mark.parametrize("name", ["fig11-slow", "fig11-joint2"])
-def test_mujoco_replays_the_logged_torques(runs, name: str) -> None:  # noqa: ANN001
+def test_mujoco_replays_the_logged_torques(runs: Runs, name: str) -> None:
     """An independent engine, fed the same held torques, gives the same base deflection."""
     sim = runs(name)
     model, log = sim.model, sim.log
