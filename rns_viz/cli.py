@@ -41,6 +41,16 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"port must be 0..65535, got {value}")
+    return value
+
+
 def _load_model(name: str):
     from rns_viz.model import FsmsModel
 
@@ -104,6 +114,48 @@ def cmd_paths(args: argparse.Namespace) -> None:
     print(f"wrote {len(paths)} paths ({sum(len(p.s) for p in paths)} points; ends: {', '.join(ends)}) to {out}")
 
 
+def cmd_run(args: argparse.Namespace) -> None:
+    from rns_viz.scenarios import SCENARIOS, run_scenario
+    from rns_viz.sim import SimulationDiverged
+
+    if args.scenario not in SCENARIOS:
+        raise CliError(f"unknown scenario {args.scenario!r}; choose one of: {', '.join(SCENARIOS)}")
+    out = Path(args.csv)
+    handle = _open_for_writing(out)
+    try:
+        sim = run_scenario(args.scenario, args.duration)
+    except SimulationDiverged as exc:
+        handle.close()
+        raise CliError(f"{args.scenario}: {exc}") from None
+    with handle:
+        sim.log.write_csv(handle)
+    xb = np.abs(sim.log.column("xb_1"))
+    print(f"{args.scenario}: {len(sim.log)} steps of {sim.dt * 1e3:g} ms, peak |x_b| = {xb.max():.3e} m; wrote {out}")
+
+
+def cmd_figures(args: argparse.Namespace) -> None:
+    from rns_viz.figures import FIGURES, draw_all
+
+    names = args.only or None
+    unknown = sorted(set(names or []) - set(FIGURES))
+    if unknown:
+        raise CliError(f"unknown figure {', '.join(unknown)}; choose from: {', '.join(FIGURES)}")
+    try:
+        written = draw_all(args.out, names)
+    except ModuleNotFoundError as exc:
+        raise CliError(str(exc)) from None
+    except OSError as exc:
+        raise CliError(f"cannot write to {args.out}: {exc.strerror}") from None
+    for path in written:
+        print(path)
+
+
+def cmd_serve(args: argparse.Namespace) -> None:
+    from rns_viz.viz.app import serve
+
+    serve(model=args.model, host=args.host, port=args.port, password=args.password)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rns-viz",
@@ -120,6 +172,21 @@ def build_parser() -> argparse.ArgumentParser:
     paths.add_argument("--ds", type=_positive_float, default=0.2, help="largest step in joint space, rad")
     paths.add_argument("--csv", required=True, help="output file")
     paths.set_defaults(func=cmd_paths)
+    run = sub.add_parser("run", help="run one of the paper's experiments headless and write its log as CSV")
+    run.add_argument("scenario", help="fig3, fig4, fig10-on, fig10-off, fig11-slow, fig11-fast, fig11-joint2, fig12-on, fig12-off")
+    run.add_argument("--csv", required=True, help="output file")
+    run.add_argument("--duration", type=_positive_float, default=None, help="seconds (default: the preset's)")
+    run.set_defaults(func=cmd_run)
+    figures = sub.add_parser("figures", help="draw the paper's figures (fig3, fig4, fig8, fig10, fig11, fig12) as PNG")
+    figures.add_argument("--out", required=True, help="output directory")
+    figures.add_argument("--only", nargs="*", help="a subset of the figures")
+    figures.set_defaults(func=cmd_figures)
+    serve = sub.add_parser("serve", help="start the browser app (the default command)")
+    serve.add_argument("--model", choices=MODEL_NAMES, default="trep")
+    serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
+    serve.add_argument("--port", type=_port, default=8080)
+    serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
+    serve.set_defaults(func=cmd_serve)
     return parser
 
 

@@ -170,6 +170,15 @@ class FsmsModel:
         base = self.data.oMi[self.base_joint_id]
         return base.rotation.T @ (self.data.oMf[self.ee_frame_id].translation - base.translation)
 
+    def arm_points(self, theta: np.ndarray) -> np.ndarray:
+        """Base-frame positions (n + 1, 3) of the arm joints and the end effector, m: the arm's polyline."""
+        q = self.q(theta)
+        pin.framesForwardKinematics(self.pin_model, self.data, q)
+        base = self.data.oMi[self.base_joint_id]
+        points = [self.data.oMi[i].translation for i in range(self.m + 1, self.pin_model.njoints)]
+        points.append(self.data.oMf[self.ee_frame_id].translation)
+        return (np.array(points) - base.translation) @ base.rotation
+
     def ee_positions(self, thetas: np.ndarray) -> np.ndarray:
         """End-effector positions (K, 3) in the base frame for K configurations (K, n), x_b = 0, m."""
         model, data, fid, q = self.pin_model, self.data, self.ee_frame_id, np.zeros(self.nv)

@@ -253,7 +253,8 @@ def default_seeds(model: FsmsModel, count: int, grid: int = 16) -> np.ndarray:
     Reactionless paths of a translating base are the level sets of the potential, so seeds on
     levels spread between its minimum and maximum give a family that covers the workspace. The
     seeds lie on the joint-space segment from the potential's minimum to its maximum (found on a
-    coarse grid) and are refined onto their level by Newton steps along H_bm.
+    coarse grid; for periodic joints the segment passing nearest the default configuration) and
+    are refined onto their level by Newton steps along H_bm.
     """
     if count < 1:
         raise ValueError(f"count must be a positive number of paths, got {count}")
@@ -267,6 +268,12 @@ def default_seeds(model: FsmsModel, count: int, grid: int = 16) -> np.ndarray:
     mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, model.n)
     values = field.potentials(mesh)[:, 0]
     lo_th, hi_th = mesh[np.argmin(values)], mesh[np.argmax(values)]
+    # Periodic joints: of the 2 pi shifts of the minimum, take the one whose segment to the maximum
+    # passes nearest the default configuration, so the family covers the workspace around it.
+    periodic = (model.upper - model.lower) >= TWO_PI * (1 - 1e-6)
+    shifts = np.stack(np.meshgrid(*[[-TWO_PI, 0.0, TWO_PI] if p else [0.0] for p in periodic], indexing="ij"), -1)
+    candidates = lo_th + shifts.reshape(-1, model.n)
+    lo_th = candidates[np.argmin(np.linalg.norm(0.5 * (candidates + hi_th) - model.spec.default_configuration, axis=1))]
     line = lo_th + np.linspace(0.0, 1.0, 101)[:, None] * (hi_th - lo_th)
     line_values = field.potentials(line)[:, 0]
     levels = line_values[0] + (np.arange(count) + 0.5) / count * (line_values[-1] - line_values[0])

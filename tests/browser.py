@@ -7,11 +7,13 @@ the client's ``window.__viserMutable.nodeRefFromName`` (viser/client/src/App.tsx
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import pytest
 import viser
 from playwright.sync_api import Page, sync_playwright
 
@@ -32,6 +34,13 @@ SKIP_REASON = f"real-browser test needs Debian chromium at {CHROMIUM} (apt-get i
 
 def chromium_available() -> bool:
     return CHROMIUM.is_file()
+
+
+# CI sets RNS_VIZ_REQUIRE_BROWSER=1: there a missing chromium fails the browser tests instead of
+# skipping them.
+requires_chromium = pytest.mark.skipif(
+    not chromium_available() and os.environ.get("RNS_VIZ_REQUIRE_BROWSER") != "1", reason=SKIP_REASON
+)
 
 
 def wait_until(condition: Callable[[], object], timeout: float, what: str, poll: float = 0.05) -> None:

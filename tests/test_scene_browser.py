@@ -13,19 +13,18 @@ from rns_viz.paths import path_family, reactionless_reachable_set, trace_paths
 from rns_viz.viz import FsmsScene
 from rns_viz.viz.style import arm_reach
 from tests.browser import (
-    SKIP_REASON,
     browser_page,
-    chromium_available,
     dismiss_notifications,
     local_position,
     local_server,
+    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, pytest.mark.skipif(not chromium_available(), reason=SKIP_REASON)]
+pytestmark = [pytest.mark.browser, requires_chromium]
 
 DEFLECTION = {"trep": 0.004, "planar3r": 0.1}  # m, x_b shown (times EXAGGERATION) in the screenshot
 EXAGGERATION = {"trep": 10.0, "planar3r": 2.0}
