@@ -8,13 +8,20 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rns_viz.params import MODEL_NAMES, ModelFileError
+
+if TYPE_CHECKING:
+    from rns_viz.model import FsmsModel
+
+MODEL_HELP = "trep, planar3r, or a model's parameter file (.toml)"
 
 
 class CliError(Exception):
@@ -51,10 +58,18 @@ def _port(text: str) -> int:
     return value
 
 
-def _load_model(name: str):
+def _model_arg(text: str) -> str:
+    if text in MODEL_NAMES or text.endswith(".toml"):
+        return text
+    choices = ", ".join(MODEL_NAMES)
+    raise argparse.ArgumentTypeError(f"invalid choice: {text!r} (choose from {choices} or a .toml file)")
+
+
+def _load_model(name: str) -> FsmsModel:
+    """A bundled model by name, or any model from its parameter file (``*.toml``)."""
     from rns_viz.model import FsmsModel
 
-    return FsmsModel.from_name(name)
+    return FsmsModel.from_file(name) if name.endswith(".toml") else FsmsModel.from_name(name)
 
 
 def _open_for_writing(path: Path):
@@ -150,10 +165,18 @@ def cmd_figures(args: argparse.Namespace) -> None:
         print(path)
 
 
+LOOPBACK = ("127.0.0.1", "localhost", "::1")
+
+
 def cmd_serve(args: argparse.Namespace) -> None:
     from rns_viz.viz.app import serve
 
-    serve(model=args.model, host=args.host, port=args.port, password=args.password)
+    if args.host not in LOOPBACK and not args.host.startswith("127."):
+        gated = args.password or os.environ.get("RNS_VIZ_PASSWORD")
+        who = "" if gated else " and anyone may take control (no --password)"
+        print(f"rns-viz: warning: binding {args.host}: other machines can reach this app{who}", file=sys.stderr)
+    password = args.password or os.environ.get("RNS_VIZ_PASSWORD") or None
+    serve(model=args.model, host=args.host, port=args.port, password=password)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -164,16 +187,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command")
     info = sub.add_parser("info", help="print a model's dimensions and base parameters as JSON")
-    info.add_argument("--model", choices=MODEL_NAMES, default="trep")
+    info.add_argument("--model", type=_model_arg, default="trep", help=MODEL_HELP)
     info.set_defaults(func=cmd_info)
     paths = sub.add_parser("paths", help="write the reactionless path family (Fig. 8) as CSV")
-    paths.add_argument("--model", choices=MODEL_NAMES, default="trep")
+    paths.add_argument("--model", type=_model_arg, default="trep", help=MODEL_HELP)
     paths.add_argument("--count", type=_positive_int, default=40, help="number of paths (default 40)")
     paths.add_argument("--ds", type=_positive_float, default=0.2, help="largest step in joint space, rad")
     paths.add_argument("--csv", required=True, help="output file")
     paths.set_defaults(func=cmd_paths)
     run = sub.add_parser("run", help="run one of the paper's experiments headless and write its log as CSV")
-    run.add_argument("scenario", help="fig3, fig4, fig10-on, fig10-off, fig11-slow, fig11-fast, fig11-joint2, fig12-on, fig12-off")
+    run.add_argument("scenario", help="a preset: fig3, fig4, fig10-on/off, fig11-slow/fast/joint2, fig12-on/off")
     run.add_argument("--csv", required=True, help="output file")
     run.add_argument("--duration", type=_positive_float, default=None, help="seconds (default: the preset's)")
     run.set_defaults(func=cmd_run)

@@ -62,3 +62,38 @@ def test_bad_arguments_give_one_clear_line(args: list[str], fragment: str, tmp_p
     assert "Traceback" not in result.stderr
     assert fragment in result.stderr
     assert result.stderr.strip().splitlines()[-1].startswith(("rns-viz", "usage"))
+
+
+@pytest.mark.parametrize(
+    ("urdf", "fragment"),
+    [
+        ("<robot name='x'><link name='a'/>", "not well-formed XML at line 1"),
+        (
+            "<robot name='x'><link name='a'/><joint name='j' type='prismatic'><parent link='a'/>"
+            "<child link='zz'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>",
+            "<joint name='j'>: <child link='zz'> names no <link>",
+        ),
+        (
+            "<robot name='x'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
+            "<parent link='a'/><child link='b'/></joint></robot>",
+            "a revolute joint needs a <limit>",
+        ),
+    ],
+)
+def test_malformed_urdf_names_file_and_element(tmp_path: Path, urdf: str, fragment: str) -> None:
+    (tmp_path / "robot.urdf").write_text(urdf)
+    params = (Path(__file__).parent.parent / "assets" / "trep.toml").read_text()
+    (tmp_path / "robot.toml").write_text(params.replace('urdf = "trep.urdf"', 'urdf = "robot.urdf"'))
+    result = run("info", "--model", str(tmp_path / "robot.toml"))
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    assert "robot.urdf" in result.stderr and fragment in result.stderr
+
+
+def test_malformed_parameter_file(tmp_path: Path) -> None:
+    params = (Path(__file__).parent.parent / "assets" / "trep.toml").read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(params.replace("stiffness = [[77.9218]]", 'stiffness = [["stiff"]]'))
+    result = run("info", "--model", str(bad))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert "bad.toml: [base] stiffness must be numbers" in result.stderr
