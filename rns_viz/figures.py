@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,8 +17,13 @@ from rns_viz.paths import path_family
 from rns_viz.scenarios import run_scenario
 from rns_viz.sim import StepLog
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
-def _pyplot():  # noqa: ANN202 - matplotlib.pyplot, imported lazily (optional dependency)
+
+def _pyplot() -> ModuleType:
+    """matplotlib.pyplot with the Agg backend, imported lazily (an optional dependency)."""
     try:
         import matplotlib
     except ModuleNotFoundError:
@@ -33,7 +40,7 @@ def _col(log: StepLog, name: str) -> np.ndarray:
     return log.column(name)
 
 
-def _deflection(ax, log: StepLog, label: str | None = None, scale: float = 1e3) -> None:  # noqa: ANN001
+def _deflection(ax: Axes, log: StepLog, label: str | None = None, scale: float = 1e3) -> None:
     ax.plot(_col(log, "t"), scale * _col(log, "xb_1"), lw=1.0, label=label)
     ax.set_ylabel("base deflection x_b [mm]")
     ax.grid(alpha=0.3)
@@ -103,7 +110,11 @@ def fig8(out: Path) -> Path:
     ax.set_ylabel("y [m]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    ax.set_title("Fig. 8  Reactionless paths in the workspace of TREP\n(40 level sets of w·x_cm, end-effector in the base frame)", fontsize=10)
+    ax.set_title(
+        "Fig. 8  Reactionless paths in the workspace of TREP\n"
+        "(40 level sets of w·x_cm, end-effector in the base frame)",
+        fontsize=10,
+    )
     return _save(fig, out / "fig8.png")
 
 
@@ -164,7 +175,8 @@ def fig11(out: Path) -> Path:
         axes[0, col].grid(alpha=0.3)
         axes[0, col].legend(fontsize=7)
         axes[3, col].set_xlabel("time [s]")
-    fig.suptitle("Fig. 11  TREP path motion: (a) reactionless at two speeds, (b) link 2 only (same end points)", fontsize=10)
+    title = "Fig. 11  TREP path motion: (a) reactionless at two speeds, (b) link 2 only (same end points)"
+    fig.suptitle(title, fontsize=10)
     return _save(fig, out / "fig11.png")
 
 
@@ -188,7 +200,7 @@ FIGURES: dict[str, Callable[[Path], Path]] = {
 }
 
 
-def _save(fig, path: Path) -> Path:  # noqa: ANN001
+def _save(fig: Figure, path: Path) -> Path:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     import matplotlib.pyplot as plt

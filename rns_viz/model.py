@@ -74,6 +74,7 @@ class FsmsModel:
         self.K_b = spec.base.stiffness
         self.D_b = spec.base.damping
         self.D_m = np.diag(spec.joint_damping)
+        self.has_joint_damping = bool(np.any(spec.joint_damping))  # D_m != 0: skip D_m theta' when not
         self.arm_mass = float(sum(model.inertias[i].mass for i in range(self.m + 1, model.njoints)))
         self.base_is_translational = all(
             model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1)
@@ -115,14 +116,16 @@ class FsmsModel:
     def dynamics(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, the velocity terms c = (c_b, c_m) and H_bm' theta' at (q, v): what the laws need.
 
+        Runs at every control step. M and c are new arrays; H_bm' theta' may be a view of c.
+
         For a translating base without gravity c_b is exactly H_bm' theta' (M does not depend
         on x_b), which saves the Coriolis matrix; otherwise H_bm' comes from M' = C + C^T.
         """
         model, data, m = self.pin_model, self.data, self.m
-        M = pin.crba(model, data, q).copy()
-        c = pin.nonLinearEffects(model, data, q, v).copy()
+        M = pin.crba(model, data, q)  # pinocchio returns new arrays: nothing to copy
+        c = pin.nonLinearEffects(model, data, q, v)
         if self._cb_is_hbm_dot:
-            return M, c, c[:m].copy()
+            return M, c, c[:m]  # a view of c
         C = pin.computeCoriolisMatrix(model, data, q, v)
         return M, c, (C + C.T)[:m, m:] @ v[m:]
 
@@ -180,9 +183,13 @@ class FsmsModel:
         points.append(self.data.oMf[self.ee_frame_id].translation)
         return (np.array(points) - base.translation) @ base.rotation
 
-    def ee_positions(self, thetas: np.ndarray) -> np.ndarray:
-        """End-effector positions (K, 3) in the base frame for K configurations (K, n), x_b = 0, m."""
-        model, data, fid, q = self.pin_model, self.data, self.ee_frame_id, np.zeros(self.nv)
+    def ee_positions(self, thetas: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+        """End-effector positions (K, 3) in the base frame for K configurations (K, n), x_b = 0, m.
+
+        ``data``: pinocchio data to work in (default: the model's own, which the laws also use).
+        """
+        model, fid, q = self.pin_model, self.ee_frame_id, np.zeros(self.nv)
+        data = self.data if data is None else data
         out = np.empty((len(thetas), 3))
         for k, theta in enumerate(thetas):
             q[self.m :] = theta

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 
 def quintic(tau: float) -> tuple[float, float, float]:
     """s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 on [0, 1] and its first two derivatives (per tau)."""
@@ -60,3 +62,21 @@ class CyclicUbar:
     def __call__(self, t: float) -> tuple[float, float]:
         s, ds, _ = quintic((t - self.start) / self.ramp)
         return self.level * s, self.level * ds / self.ramp
+
+
+@dataclass(frozen=True)
+class QuinticSegment:
+    """A straight line from ``start`` to ``end`` (joint or task space), quintic in time, rest to rest.
+
+    Returns the point, its velocity and acceleration at time t (units of ``start`` per s, s^2).
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    duration: float  # s
+    t0: float = 0.0  # s
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s, ds, dds = quintic((t - self.t0) / self.duration)
+        d = self.end - self.start
+        return self.start + s * d, ds / self.duration * d, dds / self.duration**2 * d

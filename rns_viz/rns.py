@@ -5,8 +5,10 @@ Pure numpy on matrices that the model supplies; no pinocchio, no viser.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -16,9 +18,11 @@ DEFAULT_THRESHOLD = 1e-3
 DEFAULT_MAX_DAMPING = 1e-3
 
 
-@dataclass(frozen=True)
-class DampedInverse:
-    """A singularity-robust right inverse A^T (A A^T + lambda^2 E)^-1 and how close A is to singular."""
+class DampedInverse(NamedTuple):
+    """A singularity-robust right inverse A^T (A A^T + lambda^2 E)^-1 and how close A is to singular.
+
+    A named tuple rather than a dataclass: it is built at every control step.
+    """
 
     inverse: np.ndarray  # (cols, rows)
     sigma_min: float  # smallest singular value of A: the distance to singularity
@@ -36,16 +40,27 @@ def damped_pinv(
     rows = A.shape[0]
     if rows == 1:  # closed form for a single row (the 1-DOF base): ~20x cheaper than an SVD
         a = A[0]
-        sigma = float(np.sqrt(a @ a))
-        lam2 = _damping_squared(sigma, threshold, max_damping)
-        return DampedInverse((a / (sigma * sigma + lam2))[:, None], sigma, float(np.sqrt(lam2)))
+        inverse, sigma, lam2 = damped_row_inverse(a, threshold, max_damping)
+        return DampedInverse(inverse[:, None], sigma, math.sqrt(lam2))
     sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
-    lam2 = _damping_squared(sigma, threshold, max_damping)
+    lam2 = damping_squared(sigma, threshold, max_damping)
     inverse = A.T @ np.linalg.solve(A @ A.T + lam2 * np.eye(rows), np.eye(rows))
-    return DampedInverse(inverse, sigma, float(np.sqrt(lam2)))
+    return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 
-def _damping_squared(sigma: float, threshold: float, max_damping: float) -> float:
+def damped_row_inverse(a: np.ndarray, threshold: float, max_damping: float) -> tuple[np.ndarray, float, float]:
+    """The damped inverse of one row a, as the column a / (|a|^2 + lambda^2), with sigma = |a| and lambda^2.
+
+    Plain floats and two numpy calls: this runs at every control step of a 1-DOF base.
+    """
+    sigma2 = float(a.dot(a))
+    sigma = math.sqrt(sigma2)
+    lam2 = damping_squared(sigma, threshold, max_damping)
+    return a / (sigma2 + lam2), sigma, lam2
+
+
+def damping_squared(sigma: float, threshold: float, max_damping: float) -> float:
+    """lambda^2 of the damped inverse for smallest singular value sigma (0 above ``threshold``)."""
     if sigma >= threshold:
         return 0.0
     return (1.0 - (sigma / threshold) ** 2) * max_damping**2

@@ -16,8 +16,8 @@ from rns_viz.control.common import (
     Coupling,
     CouplingEvaluator,
     Gains,
+    range_acceleration,
     realize_acceleration,
-    suppression_acceleration,
 )
 from rns_viz.control.null_input import DampNullMotion, NullInput, NullOutput
 from rns_viz.model import FsmsModel
@@ -45,16 +45,19 @@ class AccelerationLaw:
         """theta'' of Eq. (15), with the coupling and null-space input it used."""
         cp = self.coupling(q, v)
         g_b = self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
-        null = self.null_input(t, cp, q, v)
-        thetaddot = suppression_acceleration(cp, g_b) - self.gains.g_m * (cp.thetadot - cp.P @ cp.thetadot) + null.Pu
-        return thetaddot, cp, null
+        null = self._null_input(t, cp, q, v)
+        return range_acceleration(cp, g_b, self.gains.g_m) + null.Pu, cp, null
+
+    def _null_input(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
+        if type(self.null_input) is DampNullMotion:  # the default: P u = -G_m P theta', without forming P
+            return NullOutput(cp.project(cp.thetadot) * -self.null_input.g_m)
+        return self.null_input(t, cp, q, v)
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
         thetaddot, cp, null = self.acceleration(t, q, v)
-        tau = realize_acceleration(self.model, cp, q, v, thetaddot)
         return ControlOutput(
-            tau=tau,
-            coupling_momentum=cp.H_bm @ cp.thetadot,
+            tau=realize_acceleration(self.model, cp, q, v, thetaddot),
+            coupling_momentum=cp.coupling_momentum,
             sigma_hbm=cp.sigma,
             sigma_jbar=null.sigma_jbar,
             theta_ref=null.theta_ref,

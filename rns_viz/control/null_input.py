@@ -13,7 +13,7 @@ import numpy as np
 from rns_viz.control.common import Coupling
 from rns_viz.control.reference import JointReference
 from rns_viz.model import FsmsModel
-from rns_viz.profiles import quintic
+from rns_viz.profiles import QuinticSegment
 from rns_viz.rns import damped_pinv
 
 
@@ -85,19 +85,7 @@ class TrackEndEffector:
         return NullOutput(inv.inverse @ rhs, sigma_jbar=inv.sigma_min, ee_ref=x_d)
 
 
-@dataclass(frozen=True)
-class TaskQuintic:
-    """Straight-line end-effector motion from ``start`` to ``end``, quintic in time (Fig. 4)."""
-
-    start: np.ndarray
-    end: np.ndarray
-    duration: float  # s
-    t0: float = 0.0  # s
-
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s, ds, dds = quintic((t - self.t0) / self.duration)
-        d = self.end - self.start
-        return self.start + s * d, ds / self.duration * d, dds / self.duration**2 * d
+TaskQuintic = QuinticSegment  # straight end-effector path, quintic in time (Fig. 4)
 
 
 @dataclass

@@ -10,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 
 from rns_viz.model import FsmsModel
-from rns_viz.profiles import quintic
+from rns_viz.profiles import QuinticSegment
 from rns_viz.rns import null_vector
 
 
@@ -31,19 +31,7 @@ class FixedReference:
         return self.theta, zero, zero
 
 
-@dataclass(frozen=True)
-class JointQuintic:
-    """Point-to-point joint motion from ``start`` to ``end`` along a straight line, quintic in time."""
-
-    start: np.ndarray
-    end: np.ndarray
-    duration: float  # s
-    t0: float = 0.0  # s
-
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s, ds, dds = quintic((t - self.t0) / self.duration)
-        d = self.end - self.start
-        return self.start + s * d, ds / self.duration * d, dds / self.duration**2 * d
+JointQuintic = QuinticSegment  # point-to-point joint motion (Fig. 11(b))
 
 
 class PathReference:
