@@ -150,4 +150,4 @@ def check_integrability(
                     continue
                 bracket = lie_bracket(column(i), column(j), theta)
                 worst = max(worst, float(np.linalg.norm(bracket - P @ bracket)) / scale)
-    return Integrability(worst < tol, worst, len(np.atleast_2d(samples)), rns_dim)
+    return Integrability(bool(worst < tol), worst, len(np.atleast_2d(samples)), rns_dim)

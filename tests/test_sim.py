@@ -195,3 +195,19 @@ def test_divergence_is_reported_not_hidden() -> None:
 def test_gains_refuse_bad_values(bad: object) -> None:
     with pytest.raises(InvalidGain):
         Gains(g_b=bad)  # type: ignore[arg-type]
+
+
+def test_cheap_integrator_is_close_to_rk4() -> None:
+    """The semi-implicit Euler option tracks the RK4 reference to within a few per cent at 1 ms."""
+    model = FsmsModel.from_name("trep")
+    theta0 = model.spec.default_configuration
+
+    def run(integrator: str) -> np.ndarray:
+        law = VelocityLaw(model, Gains(g_b=24.0, g_m=20.0), FixedReference(theta0))
+        sim = Simulator(model, law, integrator=integrator, q0=model.q(theta0, [5e-3]))
+        sim.run(3.0)
+        return sim.log.column("xb_1")
+
+    rk4, euler = run("rk4"), run("semi-implicit-euler")
+    assert np.abs(rk4 - euler).max() < 0.05 * np.abs(rk4).max()
+    assert np.abs(rk4 - euler).max() > 0  # a different integrator, not the same code path
