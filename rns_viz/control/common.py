@@ -67,60 +67,86 @@ class ControlLaw(Protocol):
 class Coupling:
     """The blocks of Eq. (1) at one state, restricted to the selected base rows S.
 
-    Built at every control step, so it is a plain slotted class and P_RNS (an n x n matrix that
-    most laws only apply to one vector) is formed on first use; :meth:`project` applies it
-    without forming it.
+    Built at every control step, so it is a plain slotted class that stores what every law uses
+    and forms the rest on access: P_RNS (an n x n matrix usually applied to one vector, see
+    :meth:`project`), H_b, x_b, x_b', H_bm' theta', theta and the (n, r) inverse.
     """
 
     __slots__ = (
-        "H_b",
         "H_bm",
-        "H_bm_pinv",
         "H_m",
         "M",
+        "_H_b_index",
+        "_H_bm_pinv",
         "_P",
+        "_hbm_dot",
+        "_m",
+        "_q",
+        "_rows",
+        "_v",
         "c",
         "coupling_momentum",
-        "hbm_dot_thetadot",
         "row_pinv",
         "sigma",
-        "theta",
         "thetadot",
-        "x_b",
-        "xdot_b",
     )
 
     def __init__(
         self,
         M: np.ndarray,
         c: np.ndarray,
-        H_b: np.ndarray,
-        H_bm: np.ndarray,
-        H_m: np.ndarray,
         hbm_dot_thetadot: np.ndarray,
-        H_bm_pinv: np.ndarray,
-        sigma: float,
+        H_bm: np.ndarray,
+        inverse: tuple[np.ndarray | None, np.ndarray | None, float],
         q: np.ndarray,
         v: np.ndarray,
-        m: int,
         rows: slice | np.ndarray,
-        row_pinv: np.ndarray | None = None,
+        H_b_index: tuple,
     ) -> None:
-        self.M = M  # (m+n, m+n) joint-space inertia matrix
+        m = len(q) - H_bm.shape[1]
+        self.M = M  # (m+n, m+n) joint-space inertia matrix of Eq. (1)
         self.c = c  # (m+n,) velocity terms (c_b, c_m)
-        self.H_b = H_b  # (r, r) selected block
         self.H_bm = H_bm  # (r, n) S H_bm
-        self.H_m = H_m  # (n, n)
-        self.hbm_dot_thetadot = hbm_dot_thetadot  # (r,) S H_bm' theta'
-        self.H_bm_pinv = H_bm_pinv  # (n, r), damped
-        self.row_pinv = row_pinv  # (n,) the single column of H_bm_pinv when r = 1, else None
-        self.sigma = sigma  # distance to singularity of S H_bm
-        self.x_b = q[rows]  # (r,) selected base deflection, m
-        self.xdot_b = v[rows]  # (r,)
-        self.theta = q[m:]
+        self.H_m = M[m:, m:]  # (n, n)
         self.thetadot = v[m:]
         self.coupling_momentum = H_bm.dot(self.thetadot)  # (r,) L = S H_bm theta', Eq. (8)
+        # The damped inverse: (n,) for a single row (r = 1) or None; (n, r) or None; sigma_min.
+        self.row_pinv, self._H_bm_pinv, self.sigma = inverse
+        self._m, self._rows, self._H_b_index = m, rows, H_b_index
+        self._q, self._v, self._hbm_dot = q, v, hbm_dot_thetadot  # (m+n,), (m+n,), (m,)
         self._P: np.ndarray | None = None
+
+    @property
+    def H_b(self) -> np.ndarray:
+        """(r, r) selected block of the base inertia."""
+        return self.M[self._H_b_index]
+
+    @property
+    def hbm_dot_thetadot(self) -> np.ndarray:
+        """(r,) S H_bm' theta'."""
+        return self._hbm_dot[self._rows]
+
+    @property
+    def x_b(self) -> np.ndarray:
+        """(r,) selected base deflection, m."""
+        return self._q[self._rows]
+
+    @property
+    def xdot_b(self) -> np.ndarray:
+        """(r,) selected base velocity, m/s."""
+        return self._v[self._rows]
+
+    @property
+    def theta(self) -> np.ndarray:
+        """(n,) joint angles, rad."""
+        return self._q[self._m :]
+
+    @property
+    def H_bm_pinv(self) -> np.ndarray:
+        """(n, r) damped H_bm^+."""
+        if self._H_bm_pinv is None:
+            self._H_bm_pinv = self.row_pinv[:, None]
+        return self._H_bm_pinv
 
     @property
     def P(self) -> np.ndarray:
@@ -134,6 +160,11 @@ class Coupling:
         if self.row_pinv is not None:
             return u - self.row_pinv * self.H_bm[0].dot(u)
         return u - self.H_bm_pinv @ (self.H_bm @ u)
+
+    def row_terms(self) -> tuple[float, float, float, float]:
+        """H_b, x_b', H_bm' theta' and L of the single selected row (r = 1), as numbers."""
+        i = self._rows.start if isinstance(self._rows, slice) else int(self._rows[0])
+        return self.M[i, i], self._v[i], self._hbm_dot[i], self.coupling_momentum[0]
 
 
 class CouplingEvaluator:
@@ -159,13 +190,13 @@ class CouplingEvaluator:
         m, rows = self.model.m, self._rows
         M, c, hbm_dot = self.model.dynamics(q, v)
         H_bm = M[rows, m:]
-        if self._single_row:  # closed form with floats (Sec. VII: TREP, the 3R)
+        if self._single_row:  # closed form with floats (TREP, the 3R)
             row_pinv, sigma, _ = damped_row_inverse(H_bm[0], self.threshold, self.max_damping)
-            H_bm_pinv = row_pinv[:, None]
+            inverse = (row_pinv, None, sigma)
         else:
-            row_pinv = None
             H_bm_pinv, sigma, _ = damped_pinv(H_bm, self.threshold, self.max_damping)
-        return Coupling(M, c, M[self._H_b_index], H_bm, M[m:, m:], hbm_dot[rows], H_bm_pinv, sigma, q, v, m, rows, row_pinv)
+            inverse = (None, H_bm_pinv, sigma)
+        return Coupling(M, c, hbm_dot, H_bm, inverse, q, v, rows, self._H_b_index)
 
 
 def realize_acceleration(
@@ -202,6 +233,6 @@ def range_acceleration(cp: Coupling, g_b: float, g_m: float) -> np.ndarray:
     (E - P) theta' = H_bm^+ H_bm theta' = H_bm^+ L (Eqs. 8, 9), also with the damped inverse.
     """
     if cp.row_pinv is not None:  # one coupling row: a scalar times the inverse column
-        y = g_b * cp.H_b[0, 0] * cp.xdot_b[0] - cp.hbm_dot_thetadot[0] - g_m * cp.coupling_momentum[0]
-        return cp.row_pinv * y
+        H_b, xdot_b, hbm_dot_thetadot, L = cp.row_terms()
+        return cp.row_pinv * (g_b * H_b * xdot_b - hbm_dot_thetadot - g_m * L)
     return cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum)

@@ -1,6 +1,7 @@
 """The plant: Eq. (1) with base spring K_b and damper D_b, joint damping D_m, external base force.
 
-Forward dynamics by pinocchio's ABA; states are (q, v) with q = (x_b, theta).
+Forward dynamics by pinocchio's ABA; states are (q, v) with q = (x_b, theta), or both stacked as
+x = (q, v) for the RK4 step, which runs at every control step and reuses its stage buffers.
 """
 
 from __future__ import annotations
@@ -10,6 +11,8 @@ import pinocchio as pin
 
 from rns_viz.model import FsmsModel
 
+RK4_WEIGHTS = np.array([1.0, 2.0, 2.0, 1.0]) / 6.0  # b_i of the classical RK4
+
 
 class Plant:
     """q'' = M^-1 (tau_gen - c) with tau_gen = (-K_b x_b - D_b x_b' + f_ext, tau - D_m theta')."""
@@ -17,41 +20,78 @@ class Plant:
     def __init__(self, model: FsmsModel) -> None:
         self.model = model
         self._data = model.pin_model.createData()  # own data: the controller may use the model's
-        self._u = np.zeros(model.nv)
-        m = model.m
+        m, nv = model.m, model.nv
+        self._u = np.zeros(nv)  # generalised force tau_gen, rebuilt for each evaluation
         self._K, self._D, self._Dm = model.K_b, model.D_b, np.diag(model.D_m).copy()
         self._scalar_base = m == 1
         self._k, self._d = float(self._K[0, 0]), float(self._D[0, 0])
         self._arm_damped = bool(np.any(self._Dm))
+        self._tau = np.zeros(model.n)
+        self._f: np.ndarray | None = None
+        self._f0 = 0.0  # f_ext as a float for a 1-DOF base
+        # RK4 stages: row s of the buffer holds (q_s, v_s, a_s); its tail (v_s, a_s) is the slope k_s.
+        self._stages = np.zeros((4, 3 * nv))
+        self._stage_q = [row[:nv] for row in self._stages]
+        self._stage_v = [row[nv : 2 * nv] for row in self._stages]
+        self._stage_a = [row[2 * nv :] for row in self._stages]
+        self._stage_x = [row[: 2 * nv] for row in self._stages]
+        self._stage_k = [row[nv:] for row in self._stages]
+        self._slopes = self._stages[:, nv:]  # (4, 2 nv): k_1 .. k_4
+        self._weights_dt = (0.0, RK4_WEIGHTS * 0.0)  # (dt, b_i dt), cached
+
+    def hold(self, tau: np.ndarray, f_ext: np.ndarray | None) -> None:
+        """Set the joint torques and base force used by :meth:`held_acceleration`."""
+        m = self.model.m
+        self._tau, self._f = tau, f_ext
+        self._u[m:] = tau
+        if self._scalar_base:
+            self._f0 = 0.0 if f_ext is None else float(f_ext[0])
+
+    def held_acceleration(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Generalised acceleration (x_b'', theta'') at (q, v) for the inputs set by :meth:`hold`."""
+        m, u = self.model.m, self._u
+        if self._scalar_base:
+            u[0] = -self._k * q.item(0) - self._d * v.item(0) + self._f0
+        else:
+            u[:m] = -self._K @ q[:m] - self._D @ v[:m]
+            if self._f is not None:
+                u[:m] += self._f
+        if self._arm_damped:
+            u[m:] = self._tau - self._Dm * v[m:]
+        return pin.aba(self.model.pin_model, self._data, q, v, u)
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None) -> np.ndarray:
         """Generalised acceleration (x_b'', theta'') for torques tau and base force f_ext."""
-        m, u = self.model.m, self._u
-        if self._scalar_base:
-            u[0] = -self._k * q[0] - self._d * v[0]
-        else:
-            u[:m] = -self._K @ q[:m] - self._D @ v[:m]
-        if f_ext is not None:
-            u[:m] += f_ext
-        u[m:] = tau
-        if self._arm_damped:
-            u[m:] -= self._Dm * v[m:]
-        return pin.aba(self.model.pin_model, self._data, q, v, u)
+        self.hold(tau, f_ext)
+        return self.held_acceleration(q, v)
 
     def rk4_step(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None, dt: float
     ) -> tuple[np.ndarray, np.ndarray]:
         """One classical RK4 step with tau and f_ext held constant over it (a digital controller)."""
-        a1 = self.acceleration(q, v, tau, f_ext)
-        h = 0.5 * dt
-        v2 = v + h * a1
-        a2 = self.acceleration(q + h * v, v2, tau, f_ext)
-        v3 = v + h * a2
-        a3 = self.acceleration(q + h * v2, v3, tau, f_ext)
-        v4 = v + dt * a3
-        a4 = self.acceleration(q + dt * v3, v4, tau, f_ext)
-        s = dt / 6.0
-        return q + s * (v + 2.0 * (v2 + v3) + v4), v + s * (a1 + 2.0 * (a2 + a3) + a4)
+        x = self.rk4_state_step(np.concatenate((q, v)), tau, f_ext, dt)
+        nv = self.model.nv
+        return x[:nv], x[nv:]
+
+    def rk4_state_step(self, x: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None, dt: float) -> np.ndarray:
+        """:meth:`rk4_step` on the stacked state x = (q, v); returns a new array.
+
+        Stages x_{s+1} = x + c_s k_s (c = dt/2, dt/2, dt) with slopes k_s = (v_s, a_s); the step is
+        x + dt (k_1 + 2 k_2 + 2 k_3 + k_4) / 6.
+        """
+        self.hold(tau, f_ext)
+        q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
+        xs[0][:] = x
+        for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
+            a[s][:] = self.held_acceleration(q[s], v[s])
+            np.add(x, c * k[s], out=xs[s + 1])
+        a[3][:] = self.held_acceleration(q[3], v[3])
+        return x + self._weights(dt).dot(self._slopes)
+
+    def _weights(self, dt: float) -> np.ndarray:
+        if self._weights_dt[0] != dt:
+            self._weights_dt = (dt, RK4_WEIGHTS * dt)
+        return self._weights_dt[1]
 
     def semi_implicit_euler_step(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None, dt: float

@@ -7,12 +7,14 @@ used where a closed-form continuous closed loop is the oracle.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from rns_viz.control.common import ControlLaw, ControlOutput
 from rns_viz.model import FsmsModel
 from rns_viz.sim.disturbance import ForceInput, NoForce
-from rns_viz.sim.log import StepLog, log_columns
+from rns_viz.sim.log import RowLayout, StepLog
 from rns_viz.sim.plant import Plant
 
 INTEGRATORS = ("rk4", "semi-implicit-euler")
@@ -51,40 +53,67 @@ class Simulator:
         self.force = force or NoForce()
         self.integrator = integrator
         self.hold_control = hold_control
-        self.log_ee = log_ee
-        r = len(model.selected)
-        p = len(model.task_rows)
-        self.log = StepLog(log_columns(model.m, model.n, r, p), log_capacity)
-        self._row = np.full(len(self.log.columns), np.nan)
-        self._p = p
+        self.log_ee = log_ee  # end-effector columns; filled when the log is read (see _complete_rows)
+        self._nv = model.nv
+        self._layout = RowLayout(model)
+        self._ee_data = model.pin_model.createData()  # log reads never touch the laws' pinocchio data
+        self.log = StepLog(self._layout.columns, log_capacity, self._complete_rows)
         self.reset(q0, v0)
+
+    # -- state: q and v are views of one stacked array x = (q, v) ------------------------------------
+    @property
+    def q(self) -> np.ndarray:
+        """(x_b, theta) at time t (a view of the state: writing into it changes the state)."""
+        return self._x[: self._nv]
+
+    @q.setter
+    def q(self, value: np.ndarray) -> None:
+        self._x = np.concatenate((self._checked(value, "q"), self._x[self._nv :]))
+
+    @property
+    def v(self) -> np.ndarray:
+        """(x_b', theta') at time t (a view of the state)."""
+        return self._x[self._nv :]
+
+    @v.setter
+    def v(self, value: np.ndarray) -> None:
+        self._x = np.concatenate((self._x[: self._nv], self._checked(value, "v")))
+
+    def _checked(self, value: np.ndarray, name: str) -> np.ndarray:
+        arr = np.array(value, dtype=float)
+        if arr.shape != (self._nv,):
+            raise ValueError(f"{name} must have {self._nv} entries")
+        return arr
 
     def reset(self, q0: np.ndarray | None = None, v0: np.ndarray | None = None, t0: float = 0.0) -> None:
         model = self.model
         self.t = t0
-        self.q = model.q(model.spec.default_configuration) if q0 is None else np.array(q0, dtype=float)
-        self.v = np.zeros(model.nv) if v0 is None else np.array(v0, dtype=float)
-        if self.q.shape != (model.nv,) or self.v.shape != (model.nv,):
+        q = model.q(model.spec.default_configuration) if q0 is None else q0
+        v = np.zeros(model.nv) if v0 is None else v0
+        if np.shape(q) != (model.nv,) or np.shape(v) != (model.nv,):
             raise ValueError(f"q0 and v0 must have {model.nv} entries")
+        self._x = np.concatenate((np.asarray(q, dtype=float), np.asarray(v, dtype=float)))
         self.log.clear()
         self.last: ControlOutput | None = None
         self.last_force: np.ndarray | None = None
 
+    # -- stepping ------------------------------------------------------------------------------------
     def step(self) -> ControlOutput:
         """Compute the control at t, advance the state by dt, log the step; returns the control."""
-        t, q, v, dt = self.t, self.q, self.v, self.dt
+        t, x, dt, nv = self.t, self._x, self.dt, self._nv
+        q, v = x[:nv], x[nv:]
         out = self.law(t, q, v)
         f = self.force(t)
         if not self.hold_control:
-            q_next, v_next = self._rk4_continuous(t, q, v, dt)
+            x_next = np.concatenate(self._rk4_continuous(t, q, v, dt))
         elif self.integrator == "rk4":
-            q_next, v_next = self.plant.rk4_step(q, v, out.tau, f, dt)
+            x_next = self.plant.rk4_state_step(x, out.tau, f, dt)
         else:
-            q_next, v_next = self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt)
-        if not (np.all(np.isfinite(q_next)) and np.all(np.isfinite(v_next)) and np.all(np.isfinite(out.tau))):
+            x_next = np.concatenate(self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt))
+        if not (_all_finite(x_next) and _all_finite(out.tau)):
             raise SimulationDiverged(f"the state became non-finite at t = {t:.3f} s; kept the last finite state")
-        self._record(out, f)
-        self.q, self.v, self.t = q_next, v_next, t + dt
+        self._layout.write(self.log.next_row(), t, x, out, f)
+        self._x, self.t = x_next, t + dt
         self.last, self.last_force = out, f
         return out
 
@@ -103,40 +132,18 @@ class Simulator:
         s = dt / 6.0
         return q + s * (v + 2.0 * (v2 + v3) + v4), v + s * (a1 + 2.0 * (a2 + a3) + a4)
 
-    def _record(self, out: ControlOutput, f: np.ndarray | None) -> None:
-        model, row = self.model, self._row
-        m, n = model.m, model.n
-        row[:] = np.nan
-        row[0] = self.t
-        i = 1
-        row[i : i + m] = self.q[:m]
-        row[i + m : i + 2 * m] = self.v[:m]
-        i += 2 * m
-        row[i : i + n] = self.q[m:]
-        row[i + n : i + 2 * n] = self.v[m:]
-        row[i + 2 * n : i + 3 * n] = out.tau
-        i += 3 * n
-        row[i : i + m] = 0.0 if f is None else f
-        i += m
+    def _complete_rows(self, rows: np.ndarray) -> None:
+        """The end-effector columns of newly logged rows, from their joint angles (run on reading)."""
+        layout = self._layout
         if self.log_ee:
-            row[i : i + 3] = model.ee_position(self.q[m:])
-        i += 3
-        r = len(out.coupling_momentum)
-        row[i : i + r] = out.coupling_momentum
-        i += r
-        row[i] = out.sigma_hbm
-        row[i + 1] = out.sigma_jbar
-        i += 2
-        if out.theta_ref is not None:
-            row[i : i + n] = out.theta_ref
-        i += n
-        if out.ee_ref is not None:
-            row[i : i + len(out.ee_ref)] = out.ee_ref
-        self.log.append(row)
+            thetas = rows[:, layout.theta]
+            rows[:, layout.ee] = self.model.ee_positions(thetas, self._ee_data)
+        else:
+            rows[:, layout.ee] = np.nan
 
     def resize_log(self, capacity: int) -> None:
         """Keep ``capacity`` rows from now on (the current rows are dropped)."""
-        self.log = StepLog(self.log.columns, capacity)
+        self.log = StepLog(self.log.columns, capacity, self._complete_rows)
 
     def run(self, duration: float) -> StepLog:
         """Advance by ``duration`` seconds (rounded to whole steps) and return the log."""
@@ -145,3 +152,8 @@ class Simulator:
         for _ in range(round(duration / self.dt)):
             self.step()
         return self.log
+
+
+def _all_finite(a: np.ndarray) -> bool:
+    """No inf or NaN in a (checked as Python floats: for a few entries 4x cheaper than np.isfinite)."""
+    return all(map(math.isfinite, np.asarray(a).tolist()))
