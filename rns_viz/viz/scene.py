@@ -140,8 +140,11 @@ class FsmsScene:
             if trail and self.trail.push(self._trail_point()):
                 self._draw_trail()
 
-    def set_reaction_force(self, f: float) -> None:
-        """Arrow along the base axis at the base: ``f`` in N (the base reaction, paper's F_b)."""
+    def set_reaction_force(self, f: float, label: str = "F") -> None:
+        """Arrow along the base axis at the base: ``f`` in N (the base reaction, paper's F_b).
+
+        The arrow's label reads "<label> = f N".
+        """
         if f == self._force:
             return
         self._force = f
@@ -155,7 +158,7 @@ class FsmsScene:
                 tip = self._force_origin + length * self._force_axis
                 self.force.points = np.stack([self._force_origin, tip])[None]
                 self.force_label.position = tip
-                self.force_label.text = f"F = {f:.3g} N"
+                self.force_label.text = f"{label} = {f:.3g} N"
 
     # -- overlays ------------------------------------------------------------------------------
     def set_path_family(

@@ -1,0 +1,247 @@
+"""Benchmark: the live app under load, as people would use it.
+
+Run on demand (Debian chromium needed for the browser scenario):
+
+    python benchmarks/bench_app.py                     # TREP, 60 s per scenario
+    python benchmarks/bench_app.py --model planar3r --seconds 20
+
+The app runs in its own process (its CPU time is measured there, with time.process_time over all
+its threads); clients run in this process. Scenarios, each with the shadow run on:
+
+1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
+   its reactionless path; 3R: kicks) and the base is kicked every 5 s from the page's button;
+2. four protocol-level websocket clients (tests/ws_client.py), decoding everything they receive;
+3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
+   reports, for each, the time from its GUI callback to the start of the first step that used it.
+
+Printed per scenario: real-time factor (target >= 0.99), scene update rate (frames sent, target
+>= 30 Hz) and as received by a client, plot update rate (target >= 10 Hz), server CPU as % of
+one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))  # tests/ holds the browser and websocket helpers
+
+
+# ---------------------------------------------------------------- server side (a child process)
+def serve(model: str) -> None:
+    """Start the app, print its handles as JSON, then answer 'stats' lines until 'quit'."""
+    from rns_viz.viz.app import TARGET_HANDLE, start_app
+
+    out, sys.stdout = sys.stdout, sys.stderr  # viser prints a banner: keep the protocol pipe clean
+    app = start_app(model, port=0, verbose=False)
+    g = app.gui
+    info = {
+        "port": app.port,
+        "plot": g.plot_xb._impl.uuid,
+        "kick": g.kick._impl.uuid,
+        "g_b": g.gains["g_b"]._impl.uuid,
+        "cyclic": g.cyclic._impl.uuid,
+        "handle": TARGET_HANDLE,
+    }
+    print(json.dumps(info), file=out, flush=True)
+    for line in sys.stdin:
+        if line.strip() == "quit":
+            break
+        s = app.session
+        snap = s.snapshot()
+        stats = {
+            "wall": time.perf_counter(),
+            "cpu": time.process_time(),
+            "sim_t": snap.t,
+            "scene": app.scene_updates,
+            "plots": app.plot_updates,
+            "dropped": s.pacer.dropped,
+            "latencies": s.latencies(),
+            "ee": app.model.ee_position(snap.q[app.model.m :]).tolist(),
+            "clients": len(app.server.get_clients()),
+        }
+        s._latencies.clear()
+        print(json.dumps(stats), file=out, flush=True)
+    app.stop()
+
+
+# ---------------------------------------------------------------- client side
+class Server:
+    def __init__(self, model: str) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, __file__, "--serve", "--model", model],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+        self.info: dict[str, Any] = json.loads(self._line())
+
+    def _line(self) -> str:
+        assert self.proc.stdout is not None
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError("the app process ended early")
+        return line
+
+    def stats(self) -> dict[str, Any]:
+        assert self.proc.stdin is not None
+        self.proc.stdin.write("stats\n")
+        self.proc.stdin.flush()
+        return json.loads(self._line())
+
+    def close(self) -> None:
+        try:
+            assert self.proc.stdin is not None
+            self.proc.stdin.write("quit\n")
+            self.proc.stdin.flush()
+            self.proc.wait(timeout=20)
+        except Exception:
+            self.proc.kill()
+
+
+def summarize(name: str, a: dict[str, Any], b: dict[str, Any], client_rates: tuple[float, float] | None) -> None:
+    wall = b["wall"] - a["wall"]
+    rtf = (b["sim_t"] - a["sim_t"]) / wall
+    cpu = 100.0 * (b["cpu"] - a["cpu"]) / wall
+    scene = (b["scene"] - a["scene"]) / wall
+    plots = (b["plots"] - a["plots"]) / wall
+    print(f"\n== {name} ({wall:.0f} s, {b['clients']} client(s), shadow run on)")
+    print(f"  real-time factor      {rtf:6.3f}   (target >= 0.99; backlog drops: {b['dropped'] - a['dropped']})")
+    print(f"  scene updates sent    {scene:6.1f} Hz (target >= 30)")
+    print(f"  plot updates sent     {plots:6.1f} Hz (target >= 10)")
+    if client_rates is not None:
+        scene_rx, plots_rx = client_rates
+        print(f"  received by a client  {scene_rx:6.1f} Hz scene windows, {plots_rx:5.1f} Hz plot updates")
+    print(f"  server CPU            {cpu:6.1f} % of one core (target <= 60)")
+
+
+def kicker(ws: Any, uuid: str, stop: threading.Event, every: float = 5.0) -> None:
+    while not stop.wait(every):
+        ws.click(uuid)
+
+
+def scenario_browser(model: str, seconds: float) -> None:
+    from tests.browser import CHROMIUM, CHROMIUM_FLAGS, wait_until
+
+    if not CHROMIUM.is_file():
+        print(f"\n== one browser: skipped (no {CHROMIUM})")
+        return
+    from playwright.sync_api import sync_playwright
+
+    srv = Server(model)
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+            page = browser.new_page(viewport={"width": 1400, "height": 900})
+            page.goto(f"http://127.0.0.1:{srv.info['port']}/", timeout=60_000)
+            wait_until(lambda: srv.stats()["clients"] >= 1, 60.0, "the browser to connect", poll=0.5)
+            if model == "trep":
+                page.get_by_role("button", name="Start cyclic motion").click()
+            time.sleep(3.0)
+            a = srv.stats()
+            deadline = time.monotonic() + seconds
+            while time.monotonic() < deadline:
+                page.get_by_role("button", name="Kick the base").click()
+                time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
+            b = srv.stats()
+            browser.close()
+        summarize("one browser (Playwright chromium, software rendering)", a, b, None)
+    finally:
+        srv.close()
+
+
+def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
+    from tests.ws_client import WsClient
+
+    srv = Server(model)
+    clients: list[WsClient] = []
+    stop = threading.Event()
+    try:
+        clients = [WsClient(srv.info["port"]) for _ in range(count)]
+        time.sleep(2.0)
+        if model == "trep":
+            clients[0].click(srv.info["cyclic"])
+        thread = threading.Thread(target=kicker, args=(clients[0], srv.info["kick"], stop), daemon=True)
+        thread.start()
+        time.sleep(2.0)
+        a = srv.stats()
+        since = time.perf_counter()
+        time.sleep(seconds)
+        b = srv.stats()
+        probe = clients[-1]
+        rates = (probe.rate(probe.pose_times, since), probe.rate(probe.gui_times.get(srv.info["plot"], []), since))
+        summarize(f"{count} websocket clients", a, b, rates)
+    finally:
+        stop.set()
+        for c in clients:
+            c.close()
+        srv.close()
+
+
+def scenario_latency(model: str, seconds: float) -> None:
+    from tests.ws_client import WsClient
+
+    srv = Server(model)
+    ws = None
+    try:
+        ws = WsClient(srv.info["port"], decode=False)
+        time.sleep(2.0)
+        ee = srv.stats()["ee"]
+        srv.stats()  # clear the latencies so far
+        period, k = 0.05, 0
+        ws.drag(srv.info["handle"], tuple(ee), "start")
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            k += 1
+            if k % 2:  # a small target move (0.5 % of the arm's reach) and back
+                dx = 0.001 if model == "trep" else 0.015
+                ws.drag(srv.info["handle"], (ee[0] + dx * (k % 4 == 1), ee[1], ee[2]), "update")
+            else:
+                ws.set_value(srv.info["g_b"], 10.0 + 0.1 * (k % 4))
+            time.sleep(period)
+        ws.drag(srv.info["handle"], tuple(ee), "end")
+        time.sleep(0.5)
+        lat = sorted(1e3 * x for x in srv.stats()["latencies"])
+        if not lat:
+            print("\n== latency: no samples")
+            return
+        p90 = lat[int(0.9 * (len(lat) - 1))]
+        print(f"\n== latency: GUI callback -> first simulation step using the input ({len(lat)} inputs at 20 Hz)")
+        median = statistics.median(lat)
+        print(f"  median {median:.2f} ms, 90th percentile {p90:.2f} ms, max {lat[-1]:.2f} ms (target median <= 5)")
+    finally:
+        if ws is not None:
+            ws.close()
+        srv.close()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", default="trep", choices=("trep", "planar3r"))
+    parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
+    parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
+    parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.serve:
+        serve(args.model)
+        return
+    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario, 2 cores shared")
+    if args.only in (None, "browser"):
+        scenario_browser(args.model, args.seconds)
+    if args.only in (None, "clients"):
+        scenario_clients(args.model, args.seconds)
+    if args.only in (None, "latency"):
+        scenario_latency(args.model, min(args.seconds, 20.0))
+
+
+if __name__ == "__main__":
+    main()

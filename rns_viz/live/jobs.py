@@ -1,0 +1,138 @@
+"""Slow geometry for the live session, computed in a helper process.
+
+A Python-heavy computation in a thread would take turns with the simulation thread for the GIL
+and slow it down; a separate process runs beside it on another core. The helper is
+``python -m rns_viz.live.jobs`` (a plain subprocess, so no caller needs a ``__main__`` guard),
+speaking length-prefixed pickles over its stdin and stdout. :func:`call` runs one job there,
+blocking the calling thread (not the GIL) until the result is back; the helper is started on
+first use, restarted if it died, and shared by all sessions of the process.
+
+Jobs are the top-level functions below: plain arguments, picklable results.
+"""
+
+from __future__ import annotations
+
+import atexit
+import pickle
+import struct
+import subprocess
+import sys
+import threading
+from typing import IO, Any
+
+import numpy as np
+
+from rns_viz.live.path_table import PathTable, build_path_table
+from rns_viz.live.reach import ReachRegion, build_reach_region
+from rns_viz.model import FsmsModel
+from rns_viz.paths import path_family
+
+_models: dict[str, FsmsModel] = {}
+
+
+def _model(name: str) -> FsmsModel:
+    if name not in _models:
+        _models[name] = FsmsModel.from_name(name)
+    return _models[name]
+
+
+def family_curves(name: str, count: int) -> list[np.ndarray]:
+    """End-effector curves (base frame, m) of the Fig. 8 path family."""
+    return [p.ee for p in path_family(_model(name), count)]
+
+
+def path_table(name: str, seed: np.ndarray) -> PathTable:
+    return build_path_table(_model(name), seed)
+
+
+def reach_region(name: str, seed: np.ndarray) -> ReachRegion:
+    return build_reach_region(_model(name), seed)
+
+
+JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region)}
+
+
+class JobError(RuntimeError):
+    """A job failed in the helper process (the message carries its error)."""
+
+
+def _write(stream: IO[bytes], obj: Any) -> None:
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    stream.write(struct.pack("<Q", len(data)) + data)
+    stream.flush()
+
+
+def _read(stream: IO[bytes]) -> Any:
+    header = stream.read(8)
+    if len(header) < 8:
+        raise EOFError("the job helper closed its pipe")
+    (size,) = struct.unpack("<Q", header)
+    return pickle.loads(stream.read(size))
+
+
+class _Helper:
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.proc: subprocess.Popen[bytes] | None = None
+
+    def call(self, name: str, *args: Any) -> Any:
+        with self.lock:
+            for attempt in range(2):
+                proc = self._running()
+                try:
+                    assert proc.stdin is not None and proc.stdout is not None
+                    _write(proc.stdin, (name, args))
+                    ok, value = _read(proc.stdout)
+                    break
+                except (EOFError, BrokenPipeError, OSError):
+                    self.close()
+                    if attempt:
+                        raise JobError(f"the job helper died while running {name}") from None
+        if not ok:
+            raise JobError(value)
+        return value
+
+    def _running(self) -> subprocess.Popen[bytes]:
+        if self.proc is None or self.proc.poll() is not None:
+            self.proc = subprocess.Popen(
+                [sys.executable, "-m", "rns_viz.live.jobs"], stdin=subprocess.PIPE, stdout=subprocess.PIPE
+            )
+        return self.proc
+
+    def close(self) -> None:
+        proc, self.proc = self.proc, None
+        if proc is not None and proc.poll() is None:
+            try:
+                proc.stdin.close()  # type: ignore[union-attr]
+                proc.wait(timeout=2.0)
+            except Exception:
+                proc.kill()
+
+
+_helper = _Helper()
+atexit.register(_helper.close)
+
+
+def call(name: str, *args: Any) -> Any:
+    """Run job ``name`` with ``args`` in the helper process and return its result (JobError if it failed)."""
+    return _helper.call(name, *args)
+
+
+def _serve() -> None:
+    """The helper's loop: read a job, run it, write (ok, result or error text); stop at end of input."""
+    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # a stray print must not corrupt the pipe
+    while True:
+        try:
+            name, args = _read(stdin)
+        except EOFError:
+            return
+        try:
+            reply = (True, JOBS[name](*args))
+        except Exception as exc:
+            reply = (False, f"{name}: {type(exc).__name__}: {exc}")
+        _write(stdout, reply)
+
+
+if __name__ == "__main__":
+    _serve()

@@ -1,0 +1,243 @@
+"""What the operator drives in live mode: the joint reference (and, for a multi-dimensional RNS, the
+end-effector reference) that the operated and the shadow law both follow.
+
+1-D RNS (TREP): theta_ref lives on the current reactionless path (:class:`PathTable`); drags, the
+scrub slider, quintic plays and cyclic motion all move sigma = integral of u-bar dt (Eq. 30); the
+point-to-point comparison leaves the path on a joint-space quintic between the same end points.
+
+Multi-dimensional RNS (planar 3R): the target is clamped to the reactionless reachable set and
+followed by the :class:`ResolvedRate` reference.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rns_viz.live.path_table import PathTable
+from rns_viz.live.reach import ReachRegion
+from rns_viz.live.references import (
+    LiveJointReference,
+    LiveTaskTarget,
+    PathFollower,
+    ResolvedRate,
+    SigmaMotion,
+)
+from rns_viz.model import FsmsModel
+from rns_viz.profiles import QuinticSegment
+
+FIG11_SLOW_S = 5.0  # s, as scenarios.FIG11_SLOW_S
+FIG11_FAST_S = 2.5  # s
+
+
+class InputRefused(ValueError):
+    """An operator input that cannot be applied now; the message says why (shown to that client)."""
+
+
+class Operator:
+    """The live references of one model; owned and advanced by the simulation loop."""
+
+    def __init__(self, model: FsmsModel, theta0: np.ndarray, ubar_speed: float, target_speed: float) -> None:
+        self.model = model
+        self.rns_dim = model.n - len(model.selected)
+        self.on_path = self.rns_dim == 1
+        theta0 = np.array(theta0, dtype=float)
+        self.ref = LiveJointReference(theta0)
+        self.ee_z = float(model.ee_position(theta0)[2])
+        self.target: np.ndarray | None = None  # where the arm is going, base frame (m)
+        self.target_raw: np.ndarray | None = None  # where the operator put the target
+        self.table: PathTable | None = None
+        self.reach: ReachRegion | None = None
+        self.joint_move: QuinticSegment | None = None
+        self.task: LiveTaskTarget | None = None
+        self.mode = "holding"
+        if self.on_path:
+            self.follower = PathFollower(model, theta0)
+            self.motion = SigmaMotion(0.0, ubar_speed)
+        else:
+            self.rr = ResolvedRate(model, theta0, v_max=target_speed)
+            self.task = LiveTaskTarget(self.rr.x.copy())
+            self.target = self._point(self.rr.x)
+        self._moving = False
+        self.joint_move_changed = False  # set when a point-to-point move starts or ends
+        self.target_jumped = False  # set when the target moved other than by a drag (the handle follows)
+        self.dragging = False
+
+    # -- state ---------------------------------------------------------------------------------
+    @property
+    def theta_ref(self) -> np.ndarray:
+        return self.follower.theta if self.on_path else self.rr.theta
+
+    @property
+    def level(self) -> np.ndarray:
+        return self.follower.level if self.on_path else self.rr.level
+
+    @property
+    def busy(self) -> bool:
+        """The reference is moving (a re-anchor now would fight the operator)."""
+        if self.on_path:
+            return self.joint_move is not None or self.motion.moving
+        return not self.rr.idle
+
+    @property
+    def sigma(self) -> float | None:
+        """Path position shown on the scrub slider (centred for closed paths), or None."""
+        if not self.on_path or self.table is None:
+            return None
+        return self.table.centred(self.motion.sigma)
+
+    def _point(self, xy: np.ndarray) -> np.ndarray:
+        return np.array([xy[0], xy[1], self.ee_z])
+
+    def set_speeds(self, ubar_speed: float, target_speed: float) -> None:
+        if self.on_path:
+            self.motion.set_speed(ubar_speed)
+        else:
+            self.rr.follower.v_max = target_speed
+
+    # -- new configuration or overlays ---------------------------------------------------------
+    def re_anchor(self, theta: np.ndarray) -> None:
+        """Hold at ``theta`` (the arm's configuration) from now on; forgets the path table."""
+        theta = np.array(theta, dtype=float)
+        self.ref.hold(theta)
+        self.joint_move = None
+        if self.on_path:
+            self.follower.reset(theta)
+            self.motion.hold()
+            self.table = None
+        else:
+            self.rr.reset(theta)
+            task = self.task
+            assert task is not None  # the laws hold this object: update it in place
+            task.x, task.xdot, task.xddot = self.rr.x.copy(), np.zeros_like(self.rr.x), np.zeros_like(self.rr.x)
+            self.target = self._point(self.rr.x)  # the old reachable set serves until the new one is in
+        self.mode = "holding"
+
+    def accept_table(self, table: PathTable, tol: float) -> bool:
+        """Use ``table`` if it is the path theta_ref is on; sigma is re-expressed on it."""
+        if not self.on_path or np.max(np.abs(table.level - self.follower.level)) > tol:
+            return False
+        self.table = table
+        self.motion.rebase(table.sigma_nearest_theta(self.follower.theta))
+        return True
+
+    # -- operator inputs -----------------------------------------------------------------------
+    def _need_table(self) -> PathTable:
+        if self.table is None:
+            raise InputRefused("The reactionless path through the current configuration is still being computed.")
+        if self.joint_move is not None:
+            raise InputRefused("Wait until the point-to-point comparison motion has finished.")
+        return self.table
+
+    def drag(self, point: np.ndarray, final: bool = True) -> bool:
+        """Send the arm toward a target (x, y) in the base frame; True if the target had to be moved.
+
+        ``final`` is False while the operator still holds the handle (it is then never moved under them).
+        """
+        point = np.asarray(point, dtype=float)
+        self.dragging = not final
+        self.target_raw = self._point(point)
+        if self.on_path:  # 1-D RNS: the nearest point of the current reactionless path
+            table = self._need_table()
+            goal = table.nearest_copy(table.sigma_nearest_point(point), self.motion.sigma)
+            self.motion.go_to(goal)
+            self.target = self._point(table.ee_at(goal))
+            self.mode = "moving along the path to the target"
+            return False
+        clamped, moved = (point[:2].copy(), False) if self.reach is None else self.reach.clamp(point)
+        self.rr.set_goal(clamped)
+        self.target = self._point(clamped)
+        self.mode = "tracking the target"
+        return moved
+
+    def scrub(self, sigma: float) -> None:
+        """Move along the path to the slider's sigma (centred for closed paths), rate-limited by u-bar."""
+        table = self._need_table()
+        goal = table.nearest_copy(sigma, self.motion.sigma)
+        self.motion.go_to(goal)
+        self.target = self._point(table.ee_at(goal))
+        self.mode = "moving along the path (scrub)"
+
+    def half_way(self) -> float:
+        """sigma to the 'other end': half a closed path, or the farther end of an open one."""
+        table = self._need_table()
+        if table.closed:
+            return 0.5 * table.period
+        s = table.wrap(self.motion.sigma)
+        return table.hi - s if table.hi - s >= s - table.lo else table.lo - s
+
+    def play(self, t: float, duration: float) -> None:
+        """Quintic u-bar over ``duration`` s to the other end of the path (Fig. 11, slow or fast)."""
+        total = self.half_way()
+        self.motion.play(t, total, duration)
+        self.target = self._point(self.table.ee_at(self.motion.sigma + total))  # type: ignore[union-attr]
+        self.mode = f"quintic along the path, {duration:g} s"
+
+    def cyclic(self, t: float, on: bool, level: float) -> None:
+        """Start (u-bar ramps to ``level``) or stop (ramps to 0) cyclic motion along a closed path (Fig. 12)."""
+        table = self._need_table()
+        if on:
+            if not table.closed:
+                raise InputRefused("The current reactionless path is not closed: cyclic motion needs a closed path.")
+            self.motion.start_cyclic(t, level)
+            self.mode = f"cyclic along the path, u-bar = {level:g}"
+        else:
+            self.motion.stop(t)
+            self.mode = "stopping"
+
+    def point_to_point(self, t: float, duration: float = FIG11_FAST_S) -> None:
+        """Joint-space quintic to the same end point as :meth:`play` (Fig. 11(b), "link 2 only")."""
+        total = self.half_way()
+        if self.motion.moving:
+            raise InputRefused("Stop the motion along the path first.")
+        start = self.follower.theta.copy()
+        end = self.follower.end_point(total)
+        self.joint_move = QuinticSegment(start, end, duration, t0=t)
+        self.joint_move_changed = True
+        self._after_move = self.motion.sigma + total
+        self.target = self._point(self.table.ee_at(self._after_move))  # type: ignore[union-attr]
+        self.mode = "point-to-point (same end points)"
+
+    # -- per step --------------------------------------------------------------------------------
+    def advance(self, t: float, dt: float) -> None:
+        """Set the references for time t (call once, before the simulation step at t)."""
+        if not self.on_path:
+            rr = self.rr
+            was_idle = rr.idle
+            rr.step(dt)
+            if not rr.idle or not was_idle:
+                self.ref.set(rr.theta, rr.thetadot, np.zeros_like(rr.thetadot))
+                task = self.task
+                assert task is not None
+                task.x, task.xdot, task.xddot = rr.x, rr.xdot, rr.xddot
+                if rr.idle:
+                    self.mode = "holding at the target"
+            return
+        if self.joint_move is not None:
+            seg = self.joint_move
+            theta, thetadot, thetaddot = seg(t)
+            self.ref.set(theta, thetadot, thetaddot)
+            if t >= seg.t0 + seg.duration:
+                self.follower.reset(seg.end)
+                self.ref.hold(seg.end)
+                if self.table is not None:
+                    self.motion.rebase(self._after_move)
+                self.joint_move = None
+                self.joint_move_changed = True
+                self.mode = "holding"
+            return
+        motion = self.motion
+        if motion.moving:
+            before = motion.sigma
+            motion.step(t - dt, dt)
+            self.follower.advance(motion.sigma - before)
+            self.ref.set(*self.follower.reference(motion.ubar, dt))
+            self._moving = True
+            if not motion.moving:
+                self.mode = "holding"
+                if self.table is not None and not self.dragging:
+                    self.target = self._point(self.table.ee_at(motion.sigma))
+                    self.target_jumped = True
+        elif self._moving:
+            self._moving = False
+            self.follower.reference(0.0, dt)
+            self.ref.hold(self.follower.theta)

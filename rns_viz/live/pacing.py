@@ -1,0 +1,65 @@
+"""Wall-clock pacing of the simulation loop, the real-time factor and the falling-behind flag."""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+
+SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0)  # simulated seconds per wall-clock second
+MAX_BACKLOG_S = 0.1  # wall s: a longer backlog is dropped (and flagged) instead of caught up
+RTF_WINDOW_S = 1.0  # wall s over which the real-time factor is measured
+BEHIND_HOLD_S = 2.0  # wall s the falling-behind flag stays up after a dropped backlog
+
+
+class Pacer:
+    """Maps wall time to the simulated time that is due, at a chosen speed factor."""
+
+    def __init__(self, speed: float = 1.0) -> None:
+        self.speed = speed
+        self.anchor_wall = time.perf_counter()
+        self.anchor_sim = 0.0
+        self.dropped = 0  # how often a backlog was dropped
+        self._last_drop = -1e9
+        self._samples: deque[tuple[float, float]] = deque()
+
+    def reanchor(self, sim_t: float) -> None:
+        """Start pacing afresh from ``sim_t`` now (after pause, reset, speed change)."""
+        self.anchor_wall = time.perf_counter()
+        self.anchor_sim = sim_t
+        self._samples.clear()
+
+    def set_speed(self, speed: float, sim_t: float) -> None:
+        if speed not in SPEEDS:
+            raise ValueError(f"speed must be one of {SPEEDS}, got {speed}")
+        self.speed = speed
+        self.reanchor(sim_t)
+
+    def backlog(self, sim_t: float, now: float) -> float:
+        """Wall seconds the simulation is behind schedule (negative: ahead)."""
+        return (self.anchor_sim + (now - self.anchor_wall) * self.speed - sim_t) / self.speed
+
+    def drop_backlog(self, sim_t: float) -> None:
+        self.dropped += 1
+        self._last_drop = time.perf_counter()
+        self.anchor_wall = self._last_drop
+        self.anchor_sim = sim_t
+
+    def sample(self, sim_t: float, now: float) -> None:
+        """Record (wall, sim) for the real-time factor; call a few times per second or more."""
+        self._samples.append((now, sim_t))
+        while len(self._samples) > 2 and now - self._samples[0][0] > RTF_WINDOW_S:
+            self._samples.popleft()
+
+    def rtf(self) -> float:
+        """Simulated seconds per wall second over the last RTF_WINDOW_S (nan before enough data)."""
+        if len(self._samples) < 2:
+            return float("nan")
+        (w0, s0), (w1, s1) = self._samples[0], self._samples[-1]
+        return (s1 - s0) / (w1 - w0) if w1 - w0 > 0.2 else float("nan")
+
+    def behind(self) -> bool:
+        """True while the loop cannot keep up with the chosen speed."""
+        if time.perf_counter() - self._last_drop < BEHIND_HOLD_S:
+            return True
+        r = self.rtf()
+        return r == r and r < 0.95 * self.speed

@@ -1,0 +1,40 @@
+"""Ring buffers of the live plots: decimated samples over a sliding window of simulated time."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+PLOT_SERIES = ("t", "xb", "xb_shadow", "L", "L_shadow", "ee_error")
+
+
+class PlotBuffers:
+    """``capacity`` rows of PLOT_SERIES; the loop appends, any thread copies a time-ordered view."""
+
+    def __init__(self, capacity: int = 1000) -> None:
+        self._data = np.full((capacity, len(PLOT_SERIES)), np.nan)
+        self._next = 0
+        self._count = 0
+        self._lock = threading.Lock()
+        self.version = 0
+
+    def clear(self) -> None:
+        with self._lock:
+            self._next = self._count = 0
+            self.version += 1
+
+    def append(self, row: tuple[float, ...]) -> None:
+        with self._lock:
+            self._data[self._next] = row
+            self._next = (self._next + 1) % len(self._data)
+            self._count = min(self._count + 1, len(self._data))
+            self.version += 1
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Each series, oldest first (copies)."""
+        with self._lock:
+            k = self._count
+            idx = (self._next - k + np.arange(k)) % len(self._data)
+            rows = self._data[idx]
+        return {name: rows[:, i].copy() for i, name in enumerate(PLOT_SERIES)}

@@ -1,0 +1,53 @@
+"""Readouts of the live session: distances to singularity, the null-space vector, the arm's reach."""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+
+from rns_viz.live.records import Readouts
+from rns_viz.model import FsmsModel
+from rns_viz.rns import null_vector, rns_projector
+
+
+def arm_reach(model: FsmsModel) -> float:
+    """Arm reach (m): joint-to-joint distances plus the end-effector offset."""
+    pm = model.pin_model
+    links = sum(float(np.linalg.norm(pm.jointPlacements[j].translation)) for j in range(model.m + 2, pm.njoints))
+    return links + float(np.linalg.norm(pm.frames[model.ee_frame_id].placement.translation))
+
+
+def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:
+    """S H_bm, its smallest singular value, the RNS-rank-th singular value of J-bar and the RNS dimension."""
+    m = model.m
+    H = model.mass_matrix(model.q(theta))[model.selected, m:]
+    rns_dim = model.n - H.shape[0]
+    s_j = np.linalg.svd(model.ee_jacobian(theta) @ rns_projector(H), compute_uv=False)
+    k = min(len(model.task_rows), rns_dim)
+    return H, float(np.linalg.svd(H, compute_uv=False)[-1]), float(s_j[k - 1]) if k >= 1 else float("nan"), rns_dim
+
+
+@cache
+def _warning_levels(name: str) -> tuple[float, float]:
+    """10 % of both distances at the model's default configuration: below that the GUI warns."""
+    model = FsmsModel.from_name(name)
+    _, s_h, s_j, _ = _sigmas(model, model.spec.default_configuration)
+    return 0.1 * s_h, 0.1 * s_j
+
+
+def compute_readouts(model: FsmsModel, q: np.ndarray, L: float, ee_error: float, reaction: float) -> Readouts:
+    """Readouts at the configuration q = (x_b, theta); ``model`` is the loop's own instance."""
+    H, s_h, s_j, rns_dim = _sigmas(model, q[model.m :])
+    warn_h, warn_j = _warning_levels(model.name)
+    return Readouts(
+        sigma_hbm=s_h,
+        sigma_jbar=s_j,
+        warn_hbm=warn_h,
+        warn_jbar=warn_j,
+        n=tuple(float(v) for v in null_vector(H)) if rns_dim == 1 else None,
+        rns_dim=rns_dim,
+        L=L,
+        ee_error=ee_error,
+        reaction=reaction,
+    )

@@ -1,0 +1,95 @@
+"""The records the live session hands out: settings, readouts, snapshots, overlays, notices.
+
+All immutable; the simulation loop makes new ones and readers take the latest.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Literal, NamedTuple
+
+import numpy as np
+
+from rns_viz.control import Gains
+from rns_viz.live.laws import LawKind
+
+Level = Literal["info", "warning", "error"]
+
+
+class Notice(NamedTuple):
+    """A message for one client (``client`` = viser client id) or for everyone (None)."""
+
+    title: str
+    body: str
+    client: int | None
+    level: Level
+
+
+class Command(NamedTuple):
+    kind: str
+    args: tuple[Any, ...]
+    client: int | None
+    received: float  # time.perf_counter() when the input arrived
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What the operator chose; the GUI shows these."""
+
+    model: str
+    law: LawKind
+    gains: Gains
+    suppress: bool
+    ubar_speed: float  # 1/(kg m s): u-bar for scrubbing, drags and cyclic motion (1-D RNS)
+    target_speed: float  # m/s: speed limit of the smoothed target (multi-dimensional RNS)
+    shadow: bool
+    speed: float  # simulated seconds per wall second
+    preset: str | None
+
+
+@dataclass(frozen=True)
+class Readouts:
+    sigma_hbm: float = math.nan  # kg m: smallest singular value of S H_bm
+    sigma_jbar: float = math.nan  # m/rad: the RNS-rank-th singular value of J-bar = J P_RNS
+    warn_hbm: float = math.nan  # kg m: below this sigma_hbm is shown as a warning
+    warn_jbar: float = math.nan  # m/rad
+    n: tuple[float, ...] | None = None  # kg m: null-space vector of a 1-D RNS (Eq. 27)
+    rns_dim: int = 0
+    L: float = 0.0  # kg m/s: coupling momentum S H_bm theta' (first selected row)
+    ee_error: float = math.nan  # m: |x_ref - x_e|
+    reaction: float = 0.0  # N: the arm's reaction on the base, -dL/dt (low-passed)
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """The loop's state for renderers; a new object each time (never mutated)."""
+
+    epoch: int  # bumps on reset, model switch and preset load
+    settings: Settings
+    settings_version: int  # bumps when settings change other than by the operator's own input
+    steps: int
+    t: float
+    q: np.ndarray
+    q_shadow: np.ndarray | None
+    paused: bool
+    diverged: str | None
+    rtf: float
+    behind: bool
+    mode: str
+    target: np.ndarray | None  # base frame, m: where the arm is going
+    target_version: int  # bumps when the target marker or handle should jump there
+    sigma: float | None  # scrub slider position (1-D RNS), 1/(kg m)
+    sigma_range: tuple[float, float] | None
+    readouts: Readouts = field(default_factory=Readouts)
+    overlay_version: int = 0
+
+
+@dataclass(frozen=True)
+class Overlays:
+    """Heavy scene overlays; re-read when ``Snapshot.overlay_version`` changes."""
+
+    family: list[np.ndarray] | None  # Fig. 8 end-effector curves (1-D RNS)
+    current: np.ndarray | None  # the current reactionless path's end-effector curve
+    reach: np.ndarray | None  # reactionless reachable end-effector points (multi-D RNS)
+    version: int

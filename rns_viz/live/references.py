@@ -1,0 +1,366 @@
+"""References the operator moves while the simulation runs; the session advances them once per step.
+
+Both the operated and the shadow run's laws read the same reference objects, so the shadow sees the
+same operator inputs. Every reference is advanced by the session *before* the step at time t, and
+the laws then read it at t.
+
+- :class:`LiveJointReference` / :class:`LiveTaskTarget`: theta_ref and x_d with their rates, as the
+  laws' JointReference / TaskReference protocols want them.
+- :class:`SigmaMotion`: sigma = integral of u-bar dt (Eq. 30) held, driven to a goal (scrub, drag),
+  by a quintic (Fig. 11) or cyclically (Fig. 12).
+- :class:`PathFollower`: theta_ref on the reactionless path, d theta / d sigma = n(theta) by RK4.
+- :class:`ResolvedRate`: the planar 3R's reactionless resolved-rate reference,
+  theta_ref' = J-bar(theta_ref)^+ (x_f' + k (x_f - x(theta_ref))) with a damped inverse, x_f the
+  smoothed target.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from rns_viz.live.dls import damped_inverse as _damped_inverse
+from rns_viz.live.follower import Follower, ScalarFollower
+from rns_viz.model import FsmsModel
+from rns_viz.paths import CouplingField
+from rns_viz.profiles import quintic
+from rns_viz.rns import damped_pinv, null_vector
+
+
+@dataclass
+class LiveJointReference:
+    """theta_ref(t), its rate and acceleration as last set by the session (rad, rad/s, rad/s^2)."""
+
+    theta: np.ndarray
+    thetadot: np.ndarray = field(default=None)  # type: ignore[assignment]
+    thetaddot: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        self.theta = np.array(self.theta, dtype=float)
+        zero = np.zeros_like(self.theta)
+        self.thetadot = zero if self.thetadot is None else self.thetadot
+        self.thetaddot = zero.copy() if self.thetaddot is None else self.thetaddot
+
+    def set(self, theta: np.ndarray, thetadot: np.ndarray, thetaddot: np.ndarray) -> None:
+        self.theta, self.thetadot, self.thetaddot = theta, thetadot, thetaddot
+
+    def hold(self, theta: np.ndarray) -> None:
+        zero = np.zeros_like(theta)
+        self.set(np.array(theta, dtype=float), zero, zero)
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.theta, self.thetadot, self.thetaddot
+
+
+@dataclass
+class LiveTaskTarget:
+    """x_d(t), x_d', x_d'' in the base frame (task rows), as last set by the session (m, m/s, m/s^2)."""
+
+    x: np.ndarray
+    xdot: np.ndarray = field(default=None)  # type: ignore[assignment]
+    xddot: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        self.x = np.array(self.x, dtype=float)
+        self.xdot = np.zeros_like(self.x) if self.xdot is None else self.xdot
+        self.xddot = np.zeros_like(self.x) if self.xddot is None else self.xddot
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.x, self.xdot, self.xddot
+
+
+class SigmaMotion:
+    """sigma(t) and u-bar = sigma'(t): held, driven to a goal, a quintic, or cyclic with smooth ramps."""
+
+    RAMP = 1.0  # s, the smooth start and stop of cyclic motion (Sec. VII-D-3)
+    TOL = 1e-3  # 1/(kg m): a goal this close is reached (about 5e-5 rad for TREP)
+
+    def __init__(self, sigma: float = 0.0, speed: float = 30.0) -> None:
+        self.follower = ScalarFollower(sigma, speed)
+        self.mode = "hold"  # hold | goal | quintic | cyclic | stopping
+        self.goal = sigma
+        self._quintic: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)  # t0, sigma0, total, T
+        self._cyclic: tuple[float, float, float] = (0.0, 0.0, 0.0)  # t0, level, u-bar at t0
+
+    @property
+    def sigma(self) -> float:
+        return self.follower.x
+
+    @property
+    def ubar(self) -> float:
+        return self.follower.v
+
+    @property
+    def moving(self) -> bool:
+        return self.mode != "hold"
+
+    def set_speed(self, speed: float) -> None:
+        self.follower.v_max = speed
+
+    def rebase(self, sigma: float) -> None:
+        """Re-express the current position as ``sigma`` (a new table), keeping the motion's shape."""
+        shift = sigma - self.sigma
+        self.follower.x = sigma
+        self.goal += shift
+        t0, s0, total, T = self._quintic
+        self._quintic = (t0, s0 + shift, total, T)
+
+    def hold(self) -> None:
+        self.mode, self.goal = "hold", self.sigma
+        self.follower.v = 0.0
+
+    def go_to(self, goal: float) -> None:
+        self.mode, self.goal = "goal", goal
+
+    def play(self, t: float, total: float, duration: float) -> None:
+        self.mode = "quintic"
+        self._quintic = (t, self.sigma, total, duration)
+
+    def start_cyclic(self, t: float, level: float) -> None:
+        self.mode = "cyclic"
+        self._cyclic = (t, level, self.ubar)
+
+    def stop(self, t: float) -> None:
+        """Smoothly bring any motion to rest (cyclic and quintic motion ramp down over RAMP)."""
+        if self.mode in ("cyclic", "quintic"):
+            self.mode = "stopping"
+            self._cyclic = (t, 0.0, self.ubar)
+        elif self.mode == "goal":
+            self.go_to(self.sigma + self.ubar / self.follower.k)
+
+    def step(self, t: float, dt: float) -> None:
+        """Advance from t to t + dt."""
+        f = self.follower
+        if self.mode == "goal":
+            if f.step(self.goal, dt, tol=self.TOL):
+                self.mode = "hold"
+        elif self.mode == "quintic":
+            t0, s0, total, T = self._quintic
+            s, ds, _ = quintic((t + dt - t0) / T)
+            f.x, f.v = s0 + total * s, total * ds / T
+            if t + dt >= t0 + T:
+                self.hold()
+        elif self.mode in ("cyclic", "stopping"):
+            t0, level, u0 = self._cyclic
+            s, _, _ = quintic((t + dt - t0) / self.RAMP)
+            u_next = u0 + (level - u0) * s
+            f.x += 0.5 * (f.v + u_next) * dt
+            f.v = u_next
+            if self.mode == "stopping" and t + dt >= t0 + self.RAMP:
+                self.hold()
+
+
+class PathFollower:
+    """theta_ref on the reactionless path: d theta / d sigma = n(theta) (Eq. 27), RK4 in sigma.
+
+    Every ``project_every`` moves the configuration is pulled back onto the level of the coupling
+    potential it started on (Newton along H_bm), so rounding never walks it off the path.
+    """
+
+    def __init__(self, model: FsmsModel, theta: np.ndarray, project_every: int = 100) -> None:
+        self.model = model
+        self.data = model.pin_model.createData()
+        self.field = CouplingField(model)
+        self._q = np.zeros(model.nv)
+        self._planar_pair = model.n == 2 and len(model.selected) == 1 and model.selected[0] == 0
+        self.project_every = project_every
+        self.reset(theta)
+
+    def reset(self, theta: np.ndarray) -> None:
+        self.theta = np.array(theta, dtype=float)
+        self.level = self.field.potentials(self.theta[None])
+        self._moves = 0
+        self._last_rate = np.zeros_like(self.theta)
+        self._n_here: np.ndarray | None = None
+
+    def n(self, theta: np.ndarray) -> np.ndarray:
+        """Null-space vector n(theta), kg m (unnormalised)."""
+        m = self.model.m
+        self._q[m:] = theta
+        M = pin.crba(self.model.pin_model, self.data, self._q)
+        if self._planar_pair:  # Eq. (27): n = (h_2, -h_1)
+            return np.array([M[0, m + 1], -M[0, m]])
+        return null_vector(M[self.model.selected, m:])
+
+    def advance(self, dsigma: float) -> None:
+        """Move theta by dsigma along the path: midpoint steps of at most 0.01 rad in joint space.
+
+        Per 1 ms step the joint-space move is ~1e-3 rad, so the midpoint rule's local error is far
+        below the periodic projection's correction; n at the new point is kept for :meth:`reference`.
+        """
+        if dsigma == 0.0:
+            return
+        th = self.theta
+        k1 = self._n_here if self._n_here is not None else self.n(th)
+        steps = max(1, int(np.ceil(abs(dsigma) * float(np.sqrt(k1 @ k1)) / 0.01)))
+        h = dsigma / steps
+        for i in range(steps):
+            if i:
+                k1 = self.n(th)
+            th = th + h * self.n(th + 0.5 * h * k1)
+        self._moves += 1
+        if self._moves % self.project_every == 0:
+            th = self.field.project(th[None], self.level.copy(), newton_steps=2)[0]
+        self.theta = th
+        self._n_here = None
+
+    def reference(self, ubar: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """theta_ref, theta_ref' = n u-bar and theta_ref'' (backward difference over dt)."""
+        if ubar:
+            self._n_here = self.n(self.theta)
+            rate = self._n_here * ubar
+        else:
+            rate = np.zeros_like(self.theta)
+        acc = (rate - self._last_rate) / dt
+        self._last_rate = rate
+        return self.theta.copy(), rate, acc
+
+    def end_point(self, dsigma: float) -> np.ndarray:
+        """theta after moving dsigma along the path, without moving this reference."""
+        saved, moves, n_here = self.theta, self._moves, self._n_here
+        th = self.theta
+        pieces = max(1, int(np.ceil(abs(dsigma) / 0.2)))
+        h = dsigma / pieces
+        for _ in range(pieces):  # RK4 in sigma, then back onto the level
+            k1 = self.n(th)
+            k2 = self.n(th + 0.5 * h * k1)
+            k3 = self.n(th + 0.5 * h * k2)
+            k4 = self.n(th + h * k3)
+            th = th + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        out = self.field.project(th[None], self.level.copy(), newton_steps=3)[0]
+        self.theta, self._moves, self._n_here = saved, moves, n_here
+        return out
+
+
+class ResolvedRate:
+    """Reactionless resolved-rate reference for a multi-dimensional RNS (the planar 3R).
+
+    The operator's target is smoothed by a :class:`Follower` (speed ``v_max`` m/s), then
+    theta_ref' = J-bar^+ (x_f' + k (x_f - x(theta_ref))), J-bar = J P_RNS at theta_ref, damped
+    below ``threshold`` (m/rad). The smoothed target never runs more than ``leash`` ahead of the
+    reference, so at a singular curve of J-bar (a fold of the reachable set) the reference stops
+    there, slowly, instead of winding up and shaking the base; and it makes no move that takes
+    sigma_min(J-bar) below ``stop_sigma``: it stops before the singular curve (``blocked``).
+    |theta_ref'| is limited to ``joint_speed``: fast joint motion shows the discretisation of a
+    1 kHz controller as base vibration.
+    """
+
+    def __init__(
+        self,
+        model: FsmsModel,
+        theta: np.ndarray,
+        v_max: float = 1.0,
+        k: float = 10.0,
+        threshold: float = 0.05,
+        leash: float = 0.01,
+        stop_sigma: float = 0.08,
+        joint_speed: float = 1.0,
+    ) -> None:
+        self.model = model
+        self.data = model.pin_model.createData()
+        self.field = CouplingField(model)
+        self.k = k
+        self.threshold = threshold
+        self.leash = leash  # m: the smoothed target waits when it gets this far ahead of the reference
+        self.stop_sigma = stop_sigma  # m/rad: no motion that lowers sigma_min(J-bar) below this
+        self.joint_speed = joint_speed  # rad/s: |theta_ref'| at most
+        self.blocked = False
+        self._eye = np.eye(model.n)
+        self.rows = model.task_rows
+        self.follower = Follower(np.zeros(len(self.rows)), v_max)
+        self.reset(theta)
+
+    def reset(self, theta: np.ndarray, keep_goal: bool = False) -> None:
+        self.theta = np.array(theta, dtype=float)
+        self.level = self.field.potentials(self.theta[None])
+        x = self.ee(self.theta)
+        self.follower.reset(x)
+        if not keep_goal:
+            self.goal = x.copy()
+        self.thetadot = np.zeros_like(self.theta)
+        self.x, self.xdot, self.xddot = x, np.zeros_like(x), np.zeros_like(x)
+        self.sigma_jbar = float("nan")
+        self._steps = 0
+        self._next: np.ndarray | None = None
+        self.idle = not keep_goal
+
+    def _projector(self, q: np.ndarray) -> np.ndarray:
+        """P_RNS at q, from S H_bm."""
+        m = self.model.m
+        H = pin.crba(self.model.pin_model, self.data, q)[self.model.selected, m:]
+        if H.shape[0] == 1:
+            h = H[0]
+            return self._eye - np.outer(h, h) / max(float(h @ h), 1e-300)
+        return self._eye - damped_pinv(H, 1e-9, 1e-9).inverse @ H
+
+    def _sigma_at(self, theta: np.ndarray) -> float:
+        """The distance to singularity of J-bar at theta (m/rad)."""
+        pm, data, m = self.model.pin_model, self.data, self.model.m
+        q = np.concatenate([np.zeros(m), theta])
+        J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
+        J = (data.oMi[self.model.base_joint_id].rotation.T @ J_world)[self.rows]
+        return _damped_inverse(J @ self._projector(q), self.threshold)[1]
+
+    def ee(self, theta: np.ndarray) -> np.ndarray:
+        pm, data, m = self.model.pin_model, self.data, self.model.m
+        q = np.concatenate([np.zeros(m), theta])
+        pin.forwardKinematics(pm, data, q)
+        pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
+        base = data.oMi[self.model.base_joint_id]
+        return (base.rotation.T @ (data.oMf[self.model.ee_frame_id].translation - base.translation))[self.rows]
+
+    def set_goal(self, goal: np.ndarray) -> None:
+        self.goal = np.array(goal, dtype=float)[: len(self.rows)]
+        self.idle = False
+
+    def step(self, dt: float) -> None:
+        """Commit the last integration step, then set (theta', x, x', x'') at the new theta_ref.
+
+        Called once before each simulation step at time t: afterwards ``theta`` is theta_ref(t).
+        """
+        if self._next is not None:
+            self.theta, self._next = self._next, None
+            self._steps += 1
+            if self._steps % 100 == 0:
+                self.theta = self.field.project(self.theta[None], self.level.copy(), newton_steps=2)[0]
+        if self.idle:
+            return
+        f = self.follower
+        at_goal = f.step(self.goal, dt, tol=1e-6)
+        pm, data, m = self.model.pin_model, self.data, self.model.m
+        q = np.concatenate([np.zeros(m), self.theta])
+        J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
+        pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
+        base = data.oMi[self.model.base_joint_id]
+        J = (base.rotation.T @ J_world)[self.rows]
+        x = (base.rotation.T @ (data.oMf[self.model.ee_frame_id].translation - base.translation))[self.rows]
+        gap = f.x - x
+        gap_norm = float(np.sqrt(gap @ gap))
+        if gap_norm > self.leash:  # the reference is held up (a singular curve of J-bar): wait for it
+            f.x = x + gap * (self.leash / gap_norm)
+            f.v = np.zeros_like(f.v)
+            at_goal = False
+        P = self._projector(q)
+        inverse, self.sigma_jbar = _damped_inverse(J @ P, self.threshold)
+        thetadot = P @ (inverse @ (f.v + self.k * (f.x - x)))
+        speed = float(np.sqrt(thetadot @ thetadot))
+        if speed > self.joint_speed:
+            thetadot *= self.joint_speed / speed
+        self.blocked = (
+            self.sigma_jbar < self.stop_sigma and self._sigma_at(self.theta + 0.05 * thetadot) < self.sigma_jbar
+        )
+        if self.blocked:  # the way to the target crosses a singular curve of J-bar: stop before it
+            thetadot = np.zeros_like(thetadot)
+            f.x, f.v = x.copy(), np.zeros_like(f.v)
+            at_goal = False
+        xdot = J @ thetadot
+        self.xddot = (xdot - self.xdot) / dt
+        self.x, self.xdot, self.thetadot = x, xdot, thetadot
+        self._next = self.theta + thetadot * dt
+        if at_goal and float(np.abs(f.x - x).max()) < 1e-6:
+            self.idle, self._next = True, None
+            self.thetadot = np.zeros_like(thetadot)
+            self.xdot = np.zeros_like(xdot)
+            self.xddot = np.zeros_like(xdot)

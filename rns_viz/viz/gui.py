@@ -1,0 +1,257 @@
+"""The app's control panel: every GUI element, built once by :func:`make_gui`.
+
+Layout, top to bottom: a status line; *Operate* (kick, suppression, run controls); *Readouts*;
+*Live plots*; *Reactionless path* (TREP) or *Target* (planar 3R); *Control law and gains*;
+*Paper presets*; *Model and view*; *Log*. Labels carry units; hints explain the symbols.
+Model-specific elements are shown or hidden by the app.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import viser
+import viser.uplot
+
+from rns_viz.live.laws import LAW_KINDS, LAW_LABELS
+from rns_viz.live.operator import FIG11_FAST_S, FIG11_SLOW_S
+from rns_viz.live.pacing import SPEEDS
+from rns_viz.scenarios import SCENARIOS
+
+MODEL_LABELS = {"trep": "TREP (2R on a flexible beam)", "planar3r": "planar 3R on a spring"}
+SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
+TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
+PLANAR3R_PRESETS = ("fig3", "fig4")
+KICK_RANGE = {"trep": 5.0, "planar3r": 50.0}  # N, slider half range
+EXAGGERATION = {"trep": 10.0, "planar3r": 20.0}  # default drawn deflection factor
+
+# (name, label, min, max, step, hint) of every gain slider; units in the labels.
+GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
+    (
+        "g_b",
+        "g_b (1/s)",
+        0.0,
+        50.0,
+        0.1,
+        "Vibration suppression gain: base deflection (rate) feedback, Eqs. (15), (16), (30).",
+    ),
+    ("g_m", "g_m (1/s)", 0.0, 100.0, 0.1, "Joint gain: damping G_m in (15)/(16); position gain in (30)."),
+    ("G_p", "G_p (1/s²)", 0.0, 2000.0, 1.0, "End-effector position gain of Eq. (24) (planar 3R, laws 15/16)."),
+    ("G_d", "G_d (1/s)", 0.0, 500.0, 1.0, "End-effector velocity gain of Eq. (24) (planar 3R, laws 15/16)."),
+    (
+        "k_p",
+        "k_p (1/s²)",
+        0.0,
+        2000.0,
+        1.0,
+        "Joint-reference stiffness inside the reaction null space (TREP, laws 15/16).",
+    ),
+    ("k_d", "k_d (1/s)", 0.0, 200.0, 0.5, "Joint-reference damping inside the reaction null space (TREP, laws 15/16)."),
+)
+
+PLOT_COLOURS = ("#1f6fd1", "#e0503a", "#2a9d4b")
+
+
+@dataclass
+class GuiElements:
+    """Handles of everything in the panel (the app reads and wires them; tests find them here)."""
+
+    status: viser.GuiHtmlHandle
+    kick: viser.GuiButtonHandle
+    kick_peak: viser.GuiSliderHandle
+    suppression: viser.GuiCheckboxHandle
+    pause: viser.GuiButtonHandle
+    step: viser.GuiButtonHandle
+    reset: viser.GuiButtonHandle
+    speed: viser.GuiDropdownHandle
+    readouts: viser.GuiHtmlHandle
+    plot_xb: viser.GuiUplotHandle
+    plot_L: viser.GuiUplotHandle
+    plot_error: viser.GuiUplotHandle
+    path_folder: viser.GuiFolderHandle
+    sigma: viser.GuiSliderHandle
+    play_slow: viser.GuiButtonHandle
+    play_fast: viser.GuiButtonHandle
+    cyclic: viser.GuiButtonHandle
+    point_to_point: viser.GuiButtonHandle
+    ubar_speed: viser.GuiSliderHandle
+    target_folder: viser.GuiFolderHandle
+    target_speed: viser.GuiSliderHandle
+    law: viser.GuiDropdownHandle
+    gains: dict[str, viser.GuiSliderHandle]
+    presets_trep: viser.GuiButtonGroupHandle
+    presets_3r: viser.GuiButtonGroupHandle
+    preset_info: viser.GuiMarkdownHandle
+    model: viser.GuiDropdownHandle
+    exaggeration: viser.GuiSliderHandle
+    shadow: viser.GuiCheckboxHandle
+    download: viser.GuiButtonHandle
+
+
+def _plot(gui: viser.GuiApi, title: str, y_label: str, labels: tuple[str, ...]) -> viser.GuiUplotHandle:
+    import numpy as np
+
+    empty = tuple(np.zeros(2) for _ in range(len(labels) + 1))
+    series: list[viser.uplot.Series] = [{"label": "t (s)"}]
+    series += [{"label": label, "stroke": PLOT_COLOURS[i], "width": 1.5} for i, label in enumerate(labels)]
+    return gui.add_uplot(
+        data=empty,
+        series=tuple(series),
+        title=title,
+        scales={"x": {"time": False, "auto": True}, "y": {"auto": True}},
+        axes=({"label": "t (s)"}, {"label": y_label, "size": 60}),
+        legend={"show": True, "live": False},
+        cursor={"show": False},
+        aspect=1.9,
+    )
+
+
+def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
+    """Build the panel for ``model`` (its kick range and exaggeration); the app wires the callbacks."""
+    gui = server.gui
+    gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
+    gui.main_panel.dock_right()
+    status = gui.add_html("")
+    gui.add_markdown(
+        "**Try:** *Kick the base* with suppression on and off and compare the two curves below; "
+        "drag the **green handle** in the scene; load a paper experiment under *Paper presets*."
+    )
+    with gui.add_folder("Operate"):
+        kick = gui.add_button("Kick the base", icon=viser.Icon.HAND_FINGER, color="red")
+        kick_peak = gui.add_slider(
+            "Kick peak (N)",
+            min=-KICK_RANGE[model],
+            max=KICK_RANGE[model],
+            step=0.1,
+            initial_value=0.8 if model == "trep" else 5.0,
+            hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R).",
+        )
+        suppression = gui.add_checkbox(
+            "Vibration suppression", True, hint="The g_b term of the control law; the shadow run has it the other way."
+        )
+        pause = gui.add_button("Pause", icon=viser.Icon.PLAYER_PAUSE)
+        step = gui.add_button(
+            "Step 1 ms", icon=viser.Icon.PLAYER_TRACK_NEXT, hint="Pauses, then advances one 1 ms step."
+        )
+        reset = gui.add_button(
+            "Reset", icon=viser.Icon.REFRESH, hint="Back to the start (of the preset, if one is loaded)."
+        )
+        exaggeration = gui.add_slider(
+            "Deflection drawn ×",
+            min=1.0,
+            max=100.0,
+            step=1.0,
+            initial_value=EXAGGERATION[model],
+            hint="The base deflection is drawn this many times larger than simulated.",
+        )
+        speed = gui.add_dropdown(
+            "Speed",
+            tuple(SPEED_LABELS[s] for s in SPEEDS),
+            initial_value="1×",
+            hint="Simulated seconds per wall-clock second.",
+        )
+    with gui.add_folder("Readouts"):
+        readouts = gui.add_html("")
+    with gui.add_folder("Live plots (last 10 s)"):
+        plot_xb = _plot(gui, "Base deflection", "x_b (mm)", ("as operated", "shadow"))
+        plot_L = _plot(gui, "Coupling momentum", "L (kg·m/s)", ("as operated", "shadow"))
+        plot_error = _plot(gui, "End-effector tracking error", "|e| (mm)", ("|x_ref − x_e|",))
+    with gui.add_folder("Reactionless path (TREP)") as path_folder:
+        gui.add_markdown(
+            "Drag the **green handle** in the scene: the end effector moves along its current reactionless "
+            "path (red) to the point nearest the handle. Or scrub the path position."
+        )
+        sigma = gui.add_slider(
+            "Path ∫ū dt (1/(kg·m))",
+            min=-80.0,
+            max=80.0,
+            step=0.1,
+            initial_value=0.0,
+            hint="The integral of u-bar in Eq. (30): the reference's position along the reactionless path.",
+        )
+        play_slow = gui.add_button(f"Play path slowly ({FIG11_SLOW_S:g} s)", icon=viser.Icon.PLAYER_PLAY)
+        play_fast = gui.add_button(f"Play path fast ({FIG11_FAST_S:g} s)", icon=viser.Icon.PLAYER_PLAY)
+        point_to_point = gui.add_button(
+            "Same end points, joint space",
+            icon=viser.Icon.ARROWS_RIGHT_LEFT,
+            hint="Fig. 11(b): a point-to-point joint motion ('link 2 only' from the start pose) between the end "
+            "points of 'Play path fast', at the same speed. Watch the base.",
+        )
+        cyclic = gui.add_button("Start cyclic motion", icon=viser.Icon.REPEAT)
+        ubar_speed = gui.add_slider(
+            "ū speed (1/(kg·m·s))",
+            min=1.0,
+            max=100.0,
+            step=1.0,
+            initial_value=30.0,
+            hint="u-bar of cyclic motion (Fig. 12: 30), and the top speed of scrubbing and dragging.",
+        )
+    with gui.add_folder("Target (planar 3R)") as target_folder:
+        gui.add_markdown(
+            "Drag the **green handle** in the scene (x and y only). The arm follows with reactionless "
+            "end-effector control, Eq. (24). Targets outside the reactionless reachable set (lilac dots) "
+            "are clamped to its nearest point."
+        )
+        target_speed = gui.add_slider(
+            "Target speed (m/s)",
+            min=0.05,
+            max=2.0,
+            step=0.05,
+            initial_value=0.5,
+            hint="Speed limit of the smoothed target.",
+        )
+    with gui.add_folder("Control law and gains", expand_by_default=False):
+        law = gui.add_dropdown("Law", tuple(LAW_LABELS[k] for k in LAW_KINDS), initial_value=LAW_LABELS["velocity"])
+        gains = {
+            name: gui.add_slider(label, min=lo, max=hi, step=step, initial_value=lo, hint=hint)
+            for name, label, lo, hi, step, hint in GAIN_SLIDERS
+        }
+    with gui.add_folder("Paper presets", expand_by_default=False):
+        gui.add_markdown("One click loads the experiment's law, gains, motion and kicks (and switches model).")
+        presets_trep = gui.add_button_group("TREP", TREP_PRESETS)
+        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS)
+        preset_info = gui.add_markdown("")
+    with gui.add_folder("Model and view", expand_by_default=False):
+        model_dd = gui.add_dropdown("Model", tuple(MODEL_LABELS.values()), initial_value=MODEL_LABELS[model])
+        shadow = gui.add_checkbox(
+            "Shadow run", True, hint="A second simulation with the same inputs and suppression the other way."
+        )
+    download = gui.add_button("Download log (CSV)", icon=viser.Icon.DOWNLOAD)
+    return GuiElements(
+        status=status,
+        kick=kick,
+        kick_peak=kick_peak,
+        suppression=suppression,
+        pause=pause,
+        step=step,
+        reset=reset,
+        speed=speed,
+        readouts=readouts,
+        plot_xb=plot_xb,
+        plot_L=plot_L,
+        plot_error=plot_error,
+        path_folder=path_folder,
+        sigma=sigma,
+        play_slow=play_slow,
+        play_fast=play_fast,
+        cyclic=cyclic,
+        point_to_point=point_to_point,
+        ubar_speed=ubar_speed,
+        target_folder=target_folder,
+        target_speed=target_speed,
+        law=law,
+        gains=gains,
+        presets_trep=presets_trep,
+        presets_3r=presets_3r,
+        preset_info=preset_info,
+        model=model_dd,
+        exaggeration=exaggeration,
+        shadow=shadow,
+        download=download,
+    )
+
+
+def preset_description(name: str | None) -> str:
+    if name is None:
+        return ""
+    return f"**Loaded: {name}** — {SCENARIOS[name].description}. Reset restarts it."

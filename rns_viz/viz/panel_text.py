@@ -1,0 +1,76 @@
+"""Text of the panel's status line and readouts (HTML), from a session snapshot. Pure functions."""
+
+from __future__ import annotations
+
+import math
+
+from rns_viz.session import Snapshot
+
+OK_COLOUR = "#1b7f3b"
+WARN_COLOUR = "#c77700"
+BAD_COLOUR = "#c0262d"
+
+
+def _badge(text: str, colour: str) -> str:
+    return (
+        f'<span style="background:{colour};color:white;border-radius:4px;padding:1px 6px;'
+        f'font-weight:600;font-size:0.8em">{text}</span>'
+    )
+
+
+def status_html(snap: Snapshot) -> str:
+    """One line: model, simulated time, real-time factor and state, with flags in colour."""
+    st = snap.settings
+    model = "TREP" if st.model == "trep" else "planar 3R"
+    if snap.diverged:
+        state = _badge("STOPPED", BAD_COLOUR)
+    elif snap.paused:
+        state = _badge("PAUSED", WARN_COLOUR)
+    else:
+        state = _badge("RUNNING", OK_COLOUR)
+    rtf = "–" if snap.paused or not math.isfinite(snap.rtf) else f"{snap.rtf:.2f}"
+    behind = " " + _badge("FALLING BEHIND", BAD_COLOUR) if snap.behind else ""
+    preset = f" · preset <b>{st.preset}</b>" if st.preset else ""
+    speed = f"{st.speed:g}×"
+    return (
+        f'<div style="font-size:0.9em;line-height:1.5">{state}{behind} <b>{model}</b>{preset}<br>'
+        f"t = {snap.t:7.2f} s · real-time factor {rtf} (speed {speed})<br>"
+        f'<span style="color:#555">arm: {snap.mode}</span></div>'
+    )
+
+
+def _value(v: float, warn: float, unit: str, digits: int = 3) -> str:
+    if not math.isfinite(v):
+        return "–"
+    colour = WARN_COLOUR if math.isfinite(warn) and v < warn else OK_COLOUR
+    if math.isfinite(warn) and v < 0.2 * warn:
+        colour = BAD_COLOUR
+    return f'<span style="color:{colour};font-weight:600">{v:.{digits}g} {unit}</span>'
+
+
+def readouts_html(snap: Snapshot) -> str:
+    r = snap.readouts
+    if r.n is not None:
+        n = "(" + ", ".join(f"{v:+.3g}" for v in r.n) + ") kg·m"
+    else:
+        n = f"{r.rns_dim}-D null space (no single n)"
+    err = "–" if not math.isfinite(r.ee_error) else f"{r.ee_error * 1e3:.3g} mm"
+    x_b = snap.q[0] * 1e3
+    rows = [
+        (
+            "σ<sub>min</sub>(H<sub>bm</sub>)",
+            _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
+            "distance to singularity of the coupling",
+        ),
+        ("σ(J̄)", _value(r.sigma_jbar, r.warn_jbar, "m/rad"), "distance to singularity of J̄ = J P<sub>RNS</sub>"),
+        ("n", n, "null-space vector, Eq. (27)"),
+        ("L = H<sub>bm</sub>θ̇", f"{r.L:+.3g} kg·m/s", "coupling momentum, Eq. (8)"),
+        ("x<sub>b</sub>", f"{x_b:+.4f} mm", "base deflection"),
+        ("end-effector error", err, "|x<sub>ref</sub> − x<sub>e</sub>|"),
+        ("reaction on base", f"{r.reaction:+.3g} N", "red arrow: −dL/dt, the arm's push on the base"),
+    ]
+    body = "".join(
+        f'<tr title="{hint}"><td style="padding-right:8px">{name}</td><td>{value}</td></tr>'
+        for name, value, hint in rows
+    )
+    return f'<table style="font-size:0.85em;width:100%">{body}</table>'

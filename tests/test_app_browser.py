@@ -1,0 +1,83 @@
+"""The live app in a real headless Chromium: controls found by their labels, operated by clicks,
+with the server's state checked after each action. Screenshots go to artifacts/app_<model>.png.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+from playwright.sync_api import Page
+
+from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
+from rns_viz.viz.scene import FsmsScene
+from tests.browser import (
+    SKIP_REASON,
+    browser_page,
+    chromium_available,
+    dismiss_notifications,
+    screenshot,
+    wait_for_frames,
+    wait_for_nodes,
+    wait_until,
+)
+
+pytestmark = [pytest.mark.browser, pytest.mark.skipif(not chromium_available(), reason=SKIP_REASON)]
+
+
+@pytest.fixture(params=["trep", "planar3r"])
+def app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
+    app = start_app(request.param, port=0, verbose=False)
+    yield app
+    app.stop()
+
+
+def click_track(page: Page, label: str, fraction: float) -> None:
+    """Click the track of the slider labelled ``label`` at ``fraction`` of its width (one action, not many
+    key presses: a software-rendered page answers each input only after its next frame)."""
+    row = page.get_by_text(label, exact=True).locator("xpath=ancestor::*[.//*[@role='slider']][1]")
+    thumb = row.get_by_role("slider")
+    thumb.scroll_into_view_if_needed()
+    track = thumb.locator("xpath=ancestor::div[contains(@class, 'mantine-Slider-root')][1]")
+    box = track.bounding_box()
+    assert box is not None
+    page.mouse.click(box["x"] + fraction * box["width"], box["y"] + 0.5 * box["height"])
+
+
+def test_operate_the_app_in_chromium(app: RnsApp) -> None:
+    s = app.session
+    name = app.model_name
+    with browser_page(app.server, width=1400, height=900) as page:
+        wait_for_nodes(page, {FsmsScene.BASE, FsmsScene.TARGET, TARGET_HANDLE})
+        dismiss_notifications(page)
+
+        # Kick: the operated run's base deflects.
+        assert abs(s.snapshot().q[0]) < 1e-6
+        page.get_by_role("button", name="Kick the base").click()
+        wait_until(lambda: abs(s.snapshot().q[0]) > 1e-4, 15.0, "the kick to deflect the base")
+
+        # Suppression off and on again.
+        box = page.get_by_role("checkbox", name="Vibration suppression")
+        box.click()
+        wait_until(lambda: not s.snapshot().settings.suppress, 10.0, "suppression to switch off")
+        box.click()
+        wait_until(lambda: s.snapshot().settings.suppress, 10.0, "suppression to switch on")
+
+        # Sliders, found by their labels: a click on the track sets the value.
+        before = app.gui.kick_peak.value
+        click_track(page, app.gui.kick_peak.label, 0.8)
+        wait_until(lambda: app.gui.kick_peak.value > before, 10.0, "the kick-peak slider to move")
+        if name == "trep":  # the path slider moves the arm along its reactionless path
+            wait_until(lambda: s.operator is not None and s.operator.table is not None, 20.0, "the path")
+            click_track(page, app.gui.sigma.label, 0.7)
+            wait_until(lambda: (s.snapshot().sigma or 0.0) > 5.0, 15.0, "the arm to move along the path")
+
+        # Let the page show the plots and overlays, then a screenshot for a person to look at.
+        wait_until(lambda: app.plot_updates > 5, 15.0, "live plot updates")
+        app.scene.set_initial_camera()  # the model's view, whatever the clicks did to the camera
+        page.mouse.move(5, 5)  # no tooltip over the panel
+        page.get_by_text("Operate", exact=True).scroll_into_view_if_needed()
+        dismiss_notifications(page)
+        wait_for_frames(page, 30)
+        path = screenshot(page, f"app_{name}")
+        assert path.stat().st_size > 10_000
