@@ -237,7 +237,8 @@ def _right_inverse_times(H: np.ndarray, r: np.ndarray) -> np.ndarray:
     """H_k^+ r_k for a stack of full-row-rank H_k (K, rows, n): the minimum-norm Newton step."""
     if H.shape[1] == 1:
         h = H[:, 0, :]
-        return h * (r[:, 0] / np.einsum("ij,ij->i", h, h))[:, None]
+        hh = np.einsum("ij,ij->i", h, h)  # 0 where H loses rank: no step there (never 0/0)
+        return h * (r[:, 0] / np.where(hh > 1e-300, hh, np.inf))[:, None]
     return np.einsum("kir,kr->ki", np.linalg.pinv(H), r)
 
 

@@ -31,6 +31,7 @@ import numpy as np
 from rns_viz.control import Gains, InvalidGain, JointServo
 from rns_viz.live import jobs
 from rns_viz.live.commands import CommandHandlers
+from rns_viz.live.guard import GUARD_EVERY, Bounds
 from rns_viz.live.kicks import KickSchedule, kick_pulse
 from rns_viz.live.laws import (
     DEFAULT_LAW,
@@ -68,6 +69,7 @@ BURST_S = 0.003  # wall s: when ahead, the loop sleeps until this much simulatio
 DEFAULT_KICK = {"trep": 0.8, "planar3r": 5.0}  # N
 FAMILY_SIZE = 24
 REACTION_TAU = 0.01  # s, low-pass of the reaction force shown by the arrow
+MAX_TARGET_M = 1e3  # m: a farther target is refused outright (clamping it would overflow nothing, but means nothing)
 
 
 class Session(CommandHandlers):
@@ -83,7 +85,7 @@ class Session(CommandHandlers):
         self._wake = threading.Event()
         self._lock = threading.Lock()  # held while stepping: log copies are consistent
         self._latencies: deque[float] = deque(maxlen=2000)
-        self._awaiting: list[float] = []
+        self._awaiting: deque[float] = deque(maxlen=1000)
         self.worker = Worker()
         self._families: dict[str, list[np.ndarray]] = {}
         self._default_tables: dict[str, PathTable] = {}
@@ -201,8 +203,8 @@ class Session(CommandHandlers):
     def set_target(self, xy: tuple[float, float] | np.ndarray, final: bool = False, client: int | None = None) -> None:
         """Drag the end-effector target to (x, y) in the base frame, m; ``final`` at the end of a drag."""
         xy = np.asarray(xy, dtype=float)[:2]
-        if xy.shape != (2,) or not np.all(np.isfinite(xy)):
-            raise ValueError(f"target must be two finite coordinates in m, got {xy}")
+        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or float(np.max(np.abs(xy))) > MAX_TARGET_M:
+            raise ValueError(f"target must be two finite coordinates within {MAX_TARGET_M:g} m, got {xy}")
         self._send("target", (xy, bool(final)), client)
 
     def scrub(self, sigma: float, client: int | None = None) -> None:
@@ -290,7 +292,8 @@ class Session(CommandHandlers):
         samples = 0
         while not self._stop:
             try:
-                if self._commands:
+                commanded = bool(self._commands)
+                if commanded:
                     self._apply_commands()
                 if self.worker.has_results():
                     self._collect()
@@ -302,8 +305,9 @@ class Session(CommandHandlers):
                     continue
                 now = time.perf_counter()
                 backlog = pacer.backlog(self.sim.t + dt, now)
-                if backlog < 0.0:  # ahead: sleep until a few steps are due (fewer wake-ups), or a command
-                    self._wake.wait(BURST_S - backlog)
+                if backlog < 0.0:  # ahead: sleep until a few steps are due (fewer wake-ups), or a command;
+                    # after a command only until the next step is due, so the input takes effect at once
+                    self._wake.wait(-backlog if commanded else BURST_S - backlog)
                     self._wake.clear()
                     continue
                 if backlog > MAX_BACKLOG_S:
@@ -349,6 +353,8 @@ class Session(CommandHandlers):
                 except Exception as exc:
                     self._resync_shadow(f"the shadow run diverged ({exc}); restarted from the operated state")
         self.steps += 1
+        if self.steps % GUARD_EVERY == 0 and self._out_of_bounds():
+            return
         L = float(out.coupling_momentum[0])
         force = -(L - self._last_L) / dt if self.steps > 1 else 0.0
         self._last_L = L
@@ -363,6 +369,19 @@ class Session(CommandHandlers):
             self._check_settled()
         if k % PUBLISH_EVERY == 0:
             self._publish()
+
+    def _out_of_bounds(self) -> bool:
+        """Pause with a message if the operated run left physical bounds; restart a stray shadow run."""
+        sim = self.sim
+        why = self._bounds.violation(sim.q, sim.v)
+        if why is not None:
+            self._fail(f"the simulation left physical bounds at t = {sim.t:.3f} s: {why}")
+            return True
+        if self.settings.shadow:
+            why = self._bounds.violation(self.shadow.q, self.shadow.v)
+            if why is not None:
+                self._resync_shadow(f"the shadow run left physical bounds ({why}); restarted from the operated state")
+        return False
 
     # -- set-up ----------------------------------------------------------------------------------
     def _default_settings(self, model: str, shadow: bool, speed: float) -> Settings:
@@ -422,6 +441,7 @@ class Session(CommandHandlers):
         self.target_version += 1
         self.paused = False
         self.diverged = None
+        self._bounds = Bounds(self.aux)
         self._last_L = 0.0
         self._reaction = 0.0
         self._last_out = None

@@ -49,6 +49,8 @@ class CommandHandlers:
         self.paused = True
 
     def _cmd_resume(self: Session, cmd: Command) -> None:
+        if self.diverged:
+            raise InputRefused(f"the simulation stopped ({self.diverged}); press Reset to start again")
         self.paused = False
         self.diverged = None
         self.pacer.reanchor(self.sim.t)

@@ -6,7 +6,8 @@ import time
 from collections import deque
 
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0)  # simulated seconds per wall-clock second
-MAX_BACKLOG_S = 0.1  # wall s: a longer backlog is dropped (and flagged) instead of caught up
+MAX_BACKLOG_S = 0.25  # wall s: a shorter stall (another process took the CPU) is caught up, a longer one
+# dropped and flagged: catching up runs the simulation faster than real time for a moment
 RTF_WINDOW_S = 1.0  # wall s over which the real-time factor is measured
 BEHIND_HOLD_S = 2.0  # wall s the falling-behind flag stays up after a dropped backlog
 

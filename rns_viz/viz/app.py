@@ -22,6 +22,7 @@ import numpy as np
 import viser
 
 from rns_viz.live.laws import LAW_KINDS, LAW_LABELS
+from rns_viz.live.operator_lock import OperatorLock
 from rns_viz.live.pacing import SPEEDS
 from rns_viz.model import FsmsModel
 from rns_viz.session import Notice, Session, Snapshot
@@ -34,6 +35,8 @@ from rns_viz.viz.gui import (
     make_gui,
     preset_description,
 )
+from rns_viz.viz.input_check import check_value
+from rns_viz.viz.operator_panel import OperatorPanels
 from rns_viz.viz.panel_text import readouts_html, status_html
 from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.style import arm_reach
@@ -45,6 +48,8 @@ TEXT_S = 0.2  # status line and readouts at 5 Hz
 TARGET_HANDLE = "/base/target_handle"
 NOTICE_COLOURS = {"info": "blue", "warning": "yellow", "error": "red"}
 REACTION_LABEL = "arm reaction"
+DRAG_LIMIT_REACHES = 10.0  # a target further than this many arm reaches from the base is refused
+REFUSAL_REPEAT_S = 2.0  # s: a watcher dragging the handle is told at most this often
 
 _LAW_OF_LABEL = {v: k for k, v in LAW_LABELS.items()}
 _MODEL_OF_LABEL = {v: k for k, v in MODEL_LABELS.items()}
@@ -58,9 +63,14 @@ class RnsApp:
         self.server = server
         self.session = session
         self.password = password
-        self._authed: set[int] = set()
+        self.lock = OperatorLock(password)
+        self.panels = OperatorPanels(self.lock, self._notify)
         self._local = threading.local()
         self._sync_request = False
+        self._good: dict[int, Any] = {}  # id(handle) -> the last good value of a GUI control
+        self._reverts: dict[int, Any] = {}  # id(handle) -> a control to set back to its last good value
+        self._drags: dict[int, np.ndarray] = {}  # client id -> last target of a drag in progress
+        self._told: dict[int, float] = {}  # client id -> when a refused drag was last reported
         snap = session.snapshot()
         self.model_name = snap.settings.model
         self.gui: GuiElements = make_gui(server, self.model_name)
@@ -69,6 +79,7 @@ class RnsApp:
         self._build_scene(snap)
         self._wire()
         server.on_client_connect(self._on_connect)
+        server.on_client_disconnect(self._on_disconnect)
         self._seen = _Seen()
         self._sync_settings(snap)
         self._stop = threading.Event()
@@ -125,6 +136,7 @@ class RnsApp:
             g.kick_peak.min, g.kick_peak.max = -KICK_RANGE[self.model_name], KICK_RANGE[self.model_name]
             g.kick_peak.value = 0.8 if self.model_name == "trep" else 5.0
             g.exaggeration.value = EXAGGERATION[self.model_name]
+        self._good[id(g.kick_peak)], self._good[id(g.exaggeration)] = g.kick_peak.value, g.exaggeration.value
         self._seen = _Seen()
         self._sync_settings(snap)
 
@@ -139,12 +151,34 @@ class RnsApp:
             self._local.quiet = False
 
     def _set(self, handle: Any, value: Any) -> None:
+        self._good[id(handle)] = value
         if handle.value != value:
             with self._quiet():
                 handle.value = value
 
+    def _revert(self, handle: Any) -> None:
+        """Show the last good value of ``handle`` again (and the settings in force) at the next frame.
+
+        Not at once: viser runs callbacks concurrently and an event carries no value of its own, so
+        a revert here could be read by the callback of a later input as that input's value."""
+        self._reverts[id(handle)] = handle
+        self._sync_request = True
+
+    def good(self, handle: Any) -> Any:
+        """The last good value of a GUI control (what the app acts on)."""
+        return self._good.get(id(handle), handle.value)
+
     def _allowed(self, client: viser.ClientHandle | None) -> bool:
-        return self.password is None or client is None or client.client_id in self._authed
+        """The server itself (client None) and the operator may operate; everyone else watches."""
+        return client is None or self.lock.is_operator(client.client_id)
+
+    def _refuse_watcher(self, client: viser.ClientHandle | None) -> None:
+        if client is None:
+            return
+        body = f"{self.lock.status(client.client_id)}. Press 'Take control' to operate."
+        if self.password is not None:
+            body += " Taking control needs the session password."
+        self._notify(client, "View only", body, "warning")
 
     def _notify(self, client: viser.ClientHandle | None, title: str, body: str, level: str) -> None:
         clients = [client] if client is not None else list(self.server.get_clients().values())
@@ -160,19 +194,26 @@ class RnsApp:
                 return
             client = event.client
             if not self._allowed(client):
-                self._notify(client, "View only", "Enter the password (reload the page) to operate.", "warning")
-                self._sync_request = True
+                self._refuse_watcher(client)
+                self._revert(handle)
                 return
+            value = event.target.value
             try:
-                act(event.target.value, None if client is None else client.client_id)
+                if not button or isinstance(handle, viser.GuiButtonGroupHandle):
+                    check_value(handle, value)
+                act(value, None if client is None else client.client_id)
+                if not button:
+                    self._good[id(handle)] = value
             except ValueError as exc:  # InvalidGain, InputRefused, bad numbers
                 self._notify(client, "Input not applied", str(exc), "warning")
-                self._sync_request = True  # show the value still in force
+                self._revert(handle)  # show the value still in force
             except Exception as exc:
                 traceback.print_exc()
                 self._notify(client, "Input not applied", f"{type(exc).__name__}: {exc}", "error")
-                self._sync_request = True
+                self._revert(handle)
 
+        if not button:
+            self._good[id(handle)] = handle.value
         if button:
             handle.on_click(callback)
         else:
@@ -180,9 +221,11 @@ class RnsApp:
 
     def _wire(self) -> None:
         g, s = self.gui, self.session
-        self._on_input(g.kick, lambda _, c: s.kick(float(g.kick_peak.value), c), button=True)
+        self._on_input(g.kick, lambda _, c: s.kick(float(self.good(g.kick_peak)), c), button=True)
+        self._on_input(g.kick_peak, lambda v, c: None)  # read at the next kick
+        self._on_input(g.exaggeration, lambda v, c: None)  # read by the render thread
         self._on_input(g.suppression, lambda v, c: s.set_suppression(bool(v), c))
-        self._on_input(g.pause, lambda _, c: s.resume(c) if s.snapshot().paused else s.pause(c), button=True)
+        self._on_input(g.pause, lambda _, c: self._pause_button(c), button=True)
         self._on_input(g.step, lambda _, c: s.single_step(1, c), button=True)
         self._on_input(g.reset, lambda _, c: s.reset(c), button=True)
         self._on_input(g.speed, lambda v, c: s.set_speed(_SPEED_OF_LABEL[v], c))
@@ -202,16 +245,53 @@ class RnsApp:
         self._on_input(g.shadow, lambda v, c: s.set_shadow(bool(v), c))
         g.download.on_click(self._on_download)
 
+    def _pause_button(self, client: int | None) -> None:
+        snap = self.session.snapshot()
+        if snap.diverged:  # the button offers the reset
+            self.session.reset(client)
+        elif snap.paused:
+            self.session.resume(client)
+        else:
+            self.session.pause(client)
+
     def _on_drag(self, event: viser.TransformControlsEvent) -> None:
         client = event.client
+        cid = None if client is None else client.client_id
         if not self._allowed(client):
             self._seen.target_version = -1  # put the handle back
+            now = time.monotonic()
+            if cid is not None and now - self._told.get(cid, -1e9) > REFUSAL_REPEAT_S:
+                self._told[cid] = now
+                self._refuse_watcher(client)
             return
-        position = np.asarray(event.target.position, dtype=float)
+        end = event.phase == "end"
         try:
-            self.session.set_target(position[:2], event.phase == "end", None if client is None else client.client_id)
+            position = np.asarray(event.target.position, dtype=float)
+            xy = position[:2]
+            if xy.shape != (2,) or not np.all(np.isfinite(position)):
+                raise ValueError(f"the target must be two finite coordinates, got {position}")
+            if float(np.hypot(*xy)) > DRAG_LIMIT_REACHES * self._reach:
+                raise ValueError(f"the target ({xy[0]:.3g}, {xy[1]:.3g}) m is far out of the arm's reach")
+            self.session.set_target(xy, end, cid)
         except ValueError as exc:
+            self._seen.target_version = -1
             self._notify(client, "Target not applied", str(exc), "warning")
+            return
+        if cid is not None:
+            if end:
+                self._drags.pop(cid, None)
+            else:
+                self._drags[cid] = xy.copy()
+
+    def _on_disconnect(self, client: viser.ClientHandle) -> None:
+        """A client left (maybe mid-drag): end its drag where it was, pass control on."""
+        cid = client.client_id
+        xy = self._drags.pop(cid, None)
+        self._told.pop(cid, None)
+        if xy is not None and self.lock.is_operator(cid):
+            with suppress(ValueError):
+                self.session.set_target(xy, True, None)
+        self.panels.remove(cid)
 
     def _on_download(self, event: viser.GuiEvent) -> None:
         if not self._allowed(event.client):
@@ -223,6 +303,7 @@ class RnsApp:
             client.send_file_download(name, data, save_immediately=True)
 
     def _on_connect(self, client: viser.ClientHandle) -> None:
+        self.panels.add(client)
         if self.password is None:
             return
         with client.gui.add_modal("rns_viz: password") as modal:
@@ -233,8 +314,7 @@ class RnsApp:
 
         @enter.on_click
         def _(_: viser.GuiEvent) -> None:
-            if text.value == self.password:
-                self._authed.add(client.client_id)
+            if self.lock.authenticate(client.client_id, text.value):
                 modal.close()
             else:
                 client.add_notification("Wrong password", "Try again, or watch only.", color="red")
@@ -249,6 +329,7 @@ class RnsApp:
         while not self._stop.is_set():
             try:
                 self._frame(next_time)
+                self.panels.refresh()
             except Exception:  # drawing must never kill the app
                 traceback.print_exc()
             crowded = len(self.server.get_clients()) >= CROWD
@@ -266,13 +347,13 @@ class RnsApp:
         if snap.epoch != seen.epoch:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
-        exaggeration = float(self.gui.exaggeration.value)
-        q = self._drawn(snap.q, exaggeration)
+        exaggeration = float(self.good(self.gui.exaggeration))
+        q = self._drawn(snap.q, exaggeration) if np.all(np.isfinite(snap.q)) else seen.q
         if exaggeration != seen.exaggeration:
             label = self.server.scene.get_handle_by_name("/base/label")
             if label is not None:
                 label.text = f"base x_b (drawn ×{exaggeration:g})"  # type: ignore[attr-defined]
-        if not np.array_equal(q, seen.q) or exaggeration != seen.exaggeration:
+        if q is not None and (not np.array_equal(q, seen.q) or exaggeration != seen.exaggeration):
             seen.q, seen.exaggeration = q, exaggeration
             with self.server.atomic():
                 self.scene.update(q, exaggeration)
@@ -284,13 +365,19 @@ class RnsApp:
         if snap.target_version != seen.target_version:
             seen.target_version = snap.target_version
             home = self._home(snap)
-            self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
+            if np.all(np.isfinite(home)):
+                self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
         target = None if snap.target is None else tuple(np.round(snap.target, 6))
+        if target is not None and not np.all(np.isfinite(target)):
+            target = seen.target  # never draw a non-finite target
         if target != seen.target:
             seen.target = target
-            self.scene.set_target(snap.target)
+            self.scene.set_target(None if target is None else np.asarray(target, dtype=float))
         for notice in self.session.pop_notices():
             self._deliver(notice)
+        while self._reverts:
+            _, handle = self._reverts.popitem()
+            self._set(handle, self.good(handle))
         if snap.settings_version != seen.settings_version or self._sync_request:
             self._sync_request = False
             seen.settings_version = snap.settings_version
@@ -315,7 +402,7 @@ class RnsApp:
         """The reaction force rounded to 4 % of the longest arrow (N): smaller changes are not drawn."""
         st = self.scene.style
         quantum = 0.04 * st.force_arrow_max / st.force_scale
-        return round(f / quantum) * quantum
+        return round(f / quantum) * quantum if np.isfinite(f) else 0.0
 
     def _deliver(self, notice: Notice) -> None:
         client = None
@@ -343,8 +430,13 @@ class RnsApp:
         if len(a["t"]) < 2:
             return
         t = a["t"]
+        if not np.all(np.isfinite(t)):
+            return
         g = self.gui
-        clean = np.nan_to_num
+
+        def clean(x: np.ndarray) -> np.ndarray:  # no NaN or inf ever reaches a plot
+            return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
+
         g.plot_xb.data = (t, clean(a["xb"]), clean(a["xb_shadow"]))
         g.plot_L.data = (t, clean(a["L"]), clean(a["L_shadow"]))
         g.plot_error.data = (t, clean(a["ee_error"]))
@@ -361,18 +453,24 @@ class RnsApp:
             g.status.content = status
         if g.readouts.content != readouts:
             g.readouts.content = readouts
-        pause_label = "Resume" if snap.paused else "Pause"
+        pause_label = "Reset (diverged)" if snap.diverged else "Resume" if snap.paused else "Pause"
         if g.pause.label != pause_label:
             g.pause.label = pause_label
-            g.pause.icon = viser.Icon.PLAYER_PLAY if snap.paused else viser.Icon.PLAYER_PAUSE
+            g.pause.icon = (
+                viser.Icon.REFRESH
+                if snap.diverged
+                else viser.Icon.PLAYER_PLAY
+                if snap.paused
+                else viser.Icon.PLAYER_PAUSE
+            )
         cyclic_label = "Stop cyclic motion" if snap.mode.startswith("cyclic") else "Start cyclic motion"
         if g.cyclic.label != cyclic_label:
             g.cyclic.label = cyclic_label
-        if snap.sigma_range is not None:
+        if snap.sigma_range is not None and np.all(np.isfinite(snap.sigma_range)):
             lo, hi = snap.sigma_range
             if (g.sigma.min, g.sigma.max) != (round(lo, 1), round(hi, 1)):
                 g.sigma.min, g.sigma.max = round(lo, 1), round(hi, 1)
-            if snap.sigma is not None and "scrub" not in snap.mode:
+            if snap.sigma is not None and np.isfinite(snap.sigma) and "scrub" not in snap.mode:
                 self._set(g.sigma, float(np.clip(round(snap.sigma, 1), g.sigma.min, g.sigma.max)))
 
     def _sync_settings(self, snap: Snapshot) -> None:

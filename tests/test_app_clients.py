@@ -1,0 +1,116 @@
+"""Many clients, real time: 8 protocol-level clients come and go at random while one drags the target.
+
+No exception reaches the server log, the simulation keeps real time, and the operator lock passes on
+when the operator's connection dies mid-drag (the target stays where it was).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import random
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from rns_viz.viz.app import TARGET_HANDLE, start_app
+from tests.browser import wait_until
+from tests.protocol_client import ProtocolClient, gui_uuid
+
+DURATION_S = 15.0  # wall seconds of churn
+CHURNERS = 6  # plus the dragging operator and one steady watcher: 8 clients
+MIN_RTF = 0.95
+
+
+def churn(port: int, stop: threading.Event, seed: int, errors: list[BaseException]) -> None:
+    rng = random.Random(seed)
+    while not stop.is_set():
+        try:
+            c = ProtocolClient(port)
+            stop.wait(rng.uniform(0.1, 1.5))
+            c.abort() if rng.random() < 0.3 else c.close()
+            stop.wait(rng.uniform(0.0, 0.5))
+        except Exception as exc:  # the test fails on any client-side trouble too
+            errors.append(exc)
+            return
+
+
+def new_client(app: object, port: int) -> tuple[ProtocolClient, int]:
+    before = set(app.server.get_clients())  # type: ignore[attr-defined]
+    c = ProtocolClient(port)
+    wait_until(lambda: set(app.server.get_clients()) - before, 10.0, "the client to register")  # type: ignore[attr-defined]
+    (cid,) = set(app.server.get_clients()) - before  # type: ignore[attr-defined]
+    return c, cid
+
+
+def test_eight_clients_come_and_go_while_one_drags(
+    capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level(logging.WARNING)
+    app = start_app("trep", port=0, realtime=True, verbose=False)
+    s = app.session
+    stop = threading.Event()
+    errors: list[BaseException] = []
+    threads = [threading.Thread(target=churn, args=(app.port, stop, k, errors)) for k in range(CHURNERS)]
+    try:
+        assert s.wait_background()
+        dragger, dragger_id = new_client(app, app.port)
+        assert app.lock.is_operator(dragger_id)
+        watcher, watcher_id = new_client(app, app.port)
+        for t in threads:
+            t.start()
+        ee = app.model.ee_position(s.snapshot().q[1:])
+        wall0, sim0 = time.perf_counter(), s.snapshot().t
+        rtfs: list[float] = []
+        k = 0
+        dragger.drag_phase(TARGET_HANDLE, "start")
+        while time.perf_counter() - wall0 < DURATION_S:
+            phase = 2 * math.pi * k / 200
+            dragger.drag(TARGET_HANDLE, (ee[0] + 0.05 * math.sin(phase), ee[1] + 0.05 * math.cos(phase), ee[2]))
+            if k % 50 == 49:
+                dragger.drag_phase(TARGET_HANDLE, "end")
+                dragger.drag_phase(TARGET_HANDLE, "start")
+            snap = s.snapshot()
+            if math.isfinite(snap.rtf):
+                rtfs.append(snap.rtf)
+            assert snap.diverged is None and not snap.paused
+            k += 1
+            time.sleep(0.02)
+        wall, sim = time.perf_counter() - wall0, s.snapshot().t - sim0
+        rtf = sim / wall
+        with capfd.disabled():
+            print(
+                f"\n8 clients for {wall:.1f} s: real-time factor {rtf:.3f} (windows {min(rtfs):.3f}..{max(rtfs):.3f})"
+            )
+        assert rtf >= MIN_RTF and np.median(rtfs) >= MIN_RTF
+
+        # The operator's tab dies mid-drag: the drag ends where it was, the watcher gets control.
+        dragger.drag(TARGET_HANDLE, (ee[0] + 0.03, ee[1] - 0.02, ee[2]))
+        time.sleep(0.3)
+        target = s.snapshot().target
+        dragger.abort()
+        wait_until(lambda: dragger_id not in app.server.get_clients(), 10.0, "the operator to be gone")
+        wait_until(lambda: app.lock.operator not in (None, dragger_id), 10.0, "control to pass on")
+        assert app.lock.operator != dragger_id and app.lock.operator in app.server.get_clients()
+        time.sleep(0.3)
+        assert target is not None and np.allclose(s.snapshot().target, target, atol=1e-6)
+        stop.set()
+        for t in threads:
+            t.join(10.0)
+        wait_until(lambda: app.lock.operator == watcher_id, 10.0, "the steady watcher to operate")
+        pulses = len(s.kicks.pulses)
+        watcher.gui_update(gui_uuid(app.gui.kick), value=True)  # the new operator's input counts
+        wait_until(lambda: len(s.kicks.pulses) > pulses, 10.0, "the new operator's kick")
+        watcher.close()
+    finally:
+        stop.set()
+        for t in threads:
+            t.join(10.0)
+        app.stop()
+    assert not errors, errors
+    out, err = capfd.readouterr()
+    assert "Traceback" not in out + err, err[-3000:]
+    bad = [r for r in caplog.records if r.levelno >= logging.ERROR]
+    assert not bad, [r.getMessage() for r in bad]
