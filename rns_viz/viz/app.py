@@ -42,7 +42,8 @@ from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.style import arm_reach
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
-CROWD = 3  # ... and at 40 Hz from this many clients on (the server encodes every update once per client)
+CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
+CROWDED_FRAME_S = 1.0 / 33.0
 PLOT_S = 1.0 / 15.0  # live plots at 15 Hz (13 Hz when crowded)
 TEXT_S = 0.2  # status line and readouts at 5 Hz
 TARGET_HANDLE = "/base/target_handle"
@@ -333,7 +334,7 @@ class RnsApp:
             except Exception:  # drawing must never kill the app
                 traceback.print_exc()
             crowded = len(self.server.get_clients()) >= CROWD
-            next_time += 1.5 * FRAME_S if crowded else FRAME_S
+            next_time += CROWDED_FRAME_S if crowded else FRAME_S
             delay = next_time - time.perf_counter()
             if delay < -0.1:
                 next_time = time.perf_counter()
