@@ -21,6 +21,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from rns_viz.model import FsmsModel
 from rns_viz.viz.app import TARGET_HANDLE, start_app
 from tests.protocol_client import ProtocolClient, gui_uuid
 
@@ -45,7 +46,9 @@ def main() -> None:
     rng = random.Random(1)
     client = ProtocolClient(app.port)
     kick = gui_uuid(app.gui.kick)
-    home = app.session.snapshot().target
+    model = FsmsModel.from_name(args.model)
+    q0 = app.session.snapshot().q
+    home = model.ee_position(q0[model.m :])  # drag around where the end effector starts
     reach = 0.15 if args.model == "trep" else 1.5
     start = time.monotonic()
     last_report, last_sim_t = start, app.session.snapshot().t
