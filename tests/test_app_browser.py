@@ -4,6 +4,7 @@ with the server's state checked after each action. Screenshots go to artifacts/a
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 
 import pytest
@@ -12,17 +13,16 @@ from playwright.sync_api import Page
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
-    SKIP_REASON,
     browser_page,
-    chromium_available,
     dismiss_notifications,
+    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, pytest.mark.skipif(not chromium_available(), reason=SKIP_REASON)]
+pytestmark = [pytest.mark.browser, requires_chromium]
 
 
 @pytest.fixture(params=["trep", "planar3r"])
@@ -69,8 +69,11 @@ def test_operate_the_app_in_chromium(app: RnsApp) -> None:
         wait_until(lambda: app.gui.kick_peak.value > before, 10.0, "the kick-peak slider to move")
         if name == "trep":  # the path slider moves the arm along its reactionless path
             wait_until(lambda: s.operator is not None and s.operator.table is not None, 20.0, "the path")
+            # The render thread sets the slider's range from the path; click only once the page has it.
+            wait_until(lambda: app.gui.sigma.max > 10.0, 20.0, "the path slider's range")
+            time.sleep(1.0)
             click_track(page, app.gui.sigma.label, 0.7)
-            wait_until(lambda: (s.snapshot().sigma or 0.0) > 5.0, 15.0, "the arm to move along the path")
+            wait_until(lambda: (s.snapshot().sigma or 0.0) > 5.0, 30.0, "the arm to move along the path")
 
         # Let the page show the plots and overlays, then a screenshot for a person to look at.
         wait_until(lambda: app.plot_updates > 5, 15.0, "live plot updates")
