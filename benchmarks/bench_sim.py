@@ -3,8 +3,10 @@
 Run on demand:  python benchmarks/bench_sim.py [--samples 4000] [--rounds 20]
 
 The step is ``Simulator.step()`` with the acceleration-based composite law (15) (AccelerationLaw,
-default null input), RK4 with the torque held over a 1 ms step, logging on. Baselines:
+default null input), RK4 with the torque held over a 1 ms step, logging on; with the native
+extension built the law and RK4 run in C++ (rns_viz.sim.native). Baselines:
 
+- "Python step": the same Simulator with ``native=False`` (law and RK4 in Python + pinocchio).
 - "MuJoCo plant": the same AccelerationLaw object driving MuJoCo's ``mj_step`` (RK4, the same URDF
   loaded by ``tests.oracles.mujoco_replay.build_model``); no log.
 - "straightforward": the same step written plainly (P_RNS formed, the paper's equations as printed,
@@ -38,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # for tests.ora
 from rns_viz.control import AccelerationLaw, Gains
 from rns_viz.model import FsmsModel
 from rns_viz.sim import Simulator
+from rns_viz.sim import native as native_step
 from tests.oracles.mujoco_replay import build_model
 
 DT = 1e-3
@@ -113,10 +116,10 @@ def initial_state(model: FsmsModel) -> tuple[np.ndarray, np.ndarray]:
     return model.q(model.spec.default_configuration, [X_B0[model.name]]), np.zeros(model.nv)
 
 
-def rns_viz_step(model: FsmsModel, log_ee: bool = True) -> Simulator:
+def rns_viz_step(model: FsmsModel, log_ee: bool = True, native: bool = True) -> Simulator:
     q0, v0 = initial_state(model)
     law = AccelerationLaw(model, GAINS[model.name])
-    return Simulator(model, law, dt=DT, q0=q0, v0=v0, log_capacity=20000, log_ee=log_ee)
+    return Simulator(model, law, dt=DT, q0=q0, v0=v0, log_capacity=20000, log_ee=log_ee, native=native)
 
 
 class MujocoDriven:
@@ -268,6 +271,7 @@ def step_variants(model: FsmsModel) -> dict[str, Callable[[], None]]:
     law, q, v = sim.law, sim.q.copy(), sim.v.copy()
     return {
         "step": sim.step,
+        "Python step": rns_viz_step(model, native=False).step,
         "step, log_ee off": sim_no_ee.step,
         "MuJoCo plant": mj.step,
         "straightforward": Straightforward(model, AccelerationLaw(model, GAINS[model.name])).step,
@@ -316,19 +320,21 @@ def ee_fill_us(model: FsmsModel, steps: int = 5000) -> float:
     return 1e6 * (filled - plain) / steps
 
 
-def trajectories_agree(model: FsmsModel, steps: int = 2000) -> tuple[float, float]:
-    """max |x_b| difference (m) of the straightforward step and of MuJoCo against the simulator."""
-    sim = rns_viz_step(model)
+def trajectories_agree(model: FsmsModel, steps: int = 2000) -> tuple[float, float, float]:
+    """max |x_b| difference (m) of the Python step, the straightforward step and MuJoCo against the simulator."""
+    sim, python = rns_viz_step(model), rns_viz_step(model, native=False)
     plain = Straightforward(model, AccelerationLaw(model, GAINS[model.name]))
     mj = MujocoDriven(model)
-    worst_plain = worst_mj = 0.0
+    worst_python = worst_plain = worst_mj = 0.0
     for _ in range(steps):
         sim.step()
+        python.step()
         plain.step()
         mj.step()
+        worst_python = max(worst_python, abs(sim.q[0] - python.q[0]))
         worst_plain = max(worst_plain, abs(sim.q[0] - plain.q[0]))
         worst_mj = max(worst_mj, abs(sim.q[0] - mj.data.qpos[mj.qadr][0]))
-    return worst_plain, worst_mj
+    return worst_python, worst_plain, worst_mj
 
 
 # -- report -----------------------------------------------------------------------------------------
@@ -350,7 +356,11 @@ def main() -> None:
             results[model.name]["ee fill"] = ee_fill_us(model)
             results[model.name]["agree"] = trajectories_agree(model)
 
+    native = (
+        "native (C++) step" if rns_viz_step(models[0]).native else f"NO native step: {native_step.unavailable_reason()}"
+    )
     print(f"Closed-loop step, AccelerationLaw (15), RK4 with torque held over dt = {DT * 1e3:g} ms; medians in µs")
+    print(f"step: {native}")
     versions = f"python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}"
     print(f"({versions}, mujoco {mujoco.__version__})")
     print()
@@ -360,16 +370,17 @@ def main() -> None:
         "step",
         "RTF 1kHz",
         "sustained",
+        "Python step",
         "MuJoCo plant",
         "ratio",
         "straightforward",
         "speed-up",
     )
-    print("{:<10}{:>8}{:>8}{:>10}{:>11}{:>14}{:>8}{:>17}{:>10}".format(*header))
+    print("{:<10}{:>8}{:>8}{:>10}{:>11}{:>13}{:>14}{:>8}{:>17}{:>10}".format(*header))
     for name, r in results.items():
         print(
             f"{name:<10}{r['n']:>8}{r['step']:>8.1f}{1e3 / r['step']:>9.1f}x{r['sustained']:>11.1f}"
-            f"{r['MuJoCo plant']:>14.1f}{r['step'] / r['MuJoCo plant']:>8.2f}"
+            f"{r['Python step']:>13.1f}{r['MuJoCo plant']:>14.1f}{r['step'] / r['MuJoCo plant']:>8.2f}"
             f"{r['straightforward']:>17.1f}{r['straightforward'] / r['step']:>9.1f}x"
         )
     print()
@@ -384,12 +395,13 @@ def main() -> None:
     print()
     print("Same trajectory? max |x_b difference| over 2 s against Simulator.step (m)")
     for name, r in results.items():
-        plain, mj = r["agree"]
-        print(f"{name:<10} straightforward {plain:.1e}   MuJoCo plant {mj:.1e}")
+        python, plain, mj = r["agree"]
+        print(f"{name:<10} Python step {python:.1e}   straightforward {plain:.1e}   MuJoCo plant {mj:.1e}")
     print()
     print(
         "step: Simulator.step() with logging (end-effector columns filled when the log is read: 'ee fill/row').\n"
         "RTF: simulated/wall time from the median; sustained: Simulator.run over 5000 steps, per step.\n"
+        "Python step: the same Simulator with native=False.\n"
         "MuJoCo plant: the same law object, mj_step (RK4) as the plant, no log; ratio = step / MuJoCo plant.\n"
         "straightforward: the same step written plainly (see the class docstring); speed-up = it / step.\n"
         "pinocchio calls: crba + nonLinearEffects + 4 x aba, the floor under any step made of them."

@@ -80,6 +80,8 @@ def _open_for_writing(path: Path):
 
 
 def cmd_info(args: argparse.Namespace) -> None:
+    from rns_viz.sim import native as native_step
+
     model = _load_model(args.model)
     q0 = model.q(model.spec.default_configuration)
     terms = model.terms(q0, np.zeros(model.nv))
@@ -102,7 +104,10 @@ def cmd_info(args: argparse.Namespace) -> None:
         "arm_mass_kg": model.arm_mass,
         "H_bm_at_default": terms.H_bm.tolist(),
         "ee_at_default_m": terms.ee.tolist(),
+        "native_step": native_step.available(),  # laws (15)/(30) + RK4 in C++ (rns_viz.sim.native)
     }
+    if not native_step.available():
+        info["native_step_unavailable"] = native_step.unavailable_reason()
     print(json.dumps(info, indent=2))
 
 

@@ -79,7 +79,8 @@ class FsmsModel:
         self.base_is_translational = all(
             model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1)
         )
-        self._cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
+        # c_b = H_bm' theta' exactly (M does not depend on x_b): see dynamics()
+        self.cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
 
     @classmethod
     def from_name(cls, name: str) -> FsmsModel:
@@ -124,7 +125,7 @@ class FsmsModel:
         model, data, m = self.pin_model, self.data, self.m
         M = pin.crba(model, data, q)  # pinocchio returns new arrays: nothing to copy
         c = pin.nonLinearEffects(model, data, q, v)
-        if self._cb_is_hbm_dot:
+        if self.cb_is_hbm_dot:
             return M, c, c[:m]  # a view of c
         C = pin.computeCoriolisMatrix(model, data, q, v)
         return M, c, (C + C.T)[:m, m:] @ v[m:]

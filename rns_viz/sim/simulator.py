@@ -3,6 +3,9 @@
 Default: RK4 at 1 ms with the torque computed once per step and held over it (a digital
 controller). ``hold_control=False`` evaluates the law at every RK4 stage (continuous time),
 used where a closed-form continuous closed loop is the oracle.
+
+For laws (15) and (30) the whole step (law + RK4) runs in C++
+when the native extension is built (:mod:`rns_viz.sim.native`); ``native=False`` forces Python.
 """
 
 from __future__ import annotations
@@ -13,11 +16,13 @@ import numpy as np
 
 from rns_viz.control.common import ControlLaw, ControlOutput
 from rns_viz.model import FsmsModel
+from rns_viz.sim import native as native_step
 from rns_viz.sim.disturbance import ForceInput, NoForce
 from rns_viz.sim.log import RowLayout, StepLog
 from rns_viz.sim.plant import Plant
 
 INTEGRATORS = ("rk4", "semi-implicit-euler")
+_DIVERGED = "the state became non-finite at t = {t:.3f} s; kept the last finite state"
 
 
 class SimulationDiverged(RuntimeError):
@@ -39,6 +44,7 @@ class Simulator:
         v0: np.ndarray | None = None,
         log_capacity: int = 20000,
         log_ee: bool = True,
+        native: bool = True,
     ) -> None:
         if not (np.isfinite(dt) and 0 < dt <= 0.05):
             raise ValueError(f"dt must be in (0, 0.05] s, got {dt}")
@@ -48,17 +54,36 @@ class Simulator:
             raise ValueError("continuous-time control needs the RK4 integrator")
         self.model = model
         self.plant = Plant(model)
-        self.law = law
         self.dt = dt
         self.force = force or NoForce()
         self.integrator = integrator
         self.hold_control = hold_control
+        self.use_native = native and native_step.available() and integrator == "rk4" and hold_control
+        self.law = law
         self.log_ee = log_ee  # end-effector columns; filled when the log is read (see _complete_rows)
         self._nv = model.nv
         self._layout = RowLayout(model)
         self._ee_data = model.pin_model.createData()  # log reads never touch the laws' pinocchio data
         self.log = StepLog(self._layout.columns, log_capacity, self._complete_rows)
         self.reset(q0, v0)
+
+    @property
+    def law(self) -> ControlLaw:
+        return self._law
+
+    @law.setter
+    def law(self, law: ControlLaw) -> None:
+        self._law = law
+        self._native = (
+            native_step.NativeStep(self.model, law)  # type: ignore[arg-type]
+            if self.use_native and native_step.supports(law)
+            else None
+        )
+
+    @property
+    def native(self) -> bool:
+        """True while steps run in C++ (see rns_viz.sim.native for the laws it covers)."""
+        return self._native is not None
 
     # -- state: q and v are views of one stacked array x = (q, v) ------------------------------------
     @property
@@ -100,18 +125,25 @@ class Simulator:
     # -- stepping ------------------------------------------------------------------------------------
     def step(self) -> ControlOutput:
         """Compute the control at t, advance the state by dt, log the step; returns the control."""
-        t, x, dt, nv = self.t, self._x, self.dt, self._nv
-        q, v = x[:nv], x[nv:]
-        out = self.law(t, q, v)
+        t, x, dt = self.t, self._x, self.dt
         f = self.force(t)
-        if not self.hold_control:
-            x_next = np.concatenate(self._rk4_continuous(t, q, v, dt))
-        elif self.integrator == "rk4":
-            x_next = self.plant.rk4_state_step(x, out.tau, f, dt)
+        try:  # law and RK4 in one C++ call, which checks finiteness (None: the law is Python's)
+            stepped = self._native(t, x, f, dt) if self._native is not None else None
+        except FloatingPointError:
+            raise SimulationDiverged(_DIVERGED.format(t=t)) from None
+        if stepped is not None:
+            x_next, out = stepped
         else:
-            x_next = np.concatenate(self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt))
-        if not (_all_finite(x_next) and _all_finite(out.tau)):
-            raise SimulationDiverged(f"the state became non-finite at t = {t:.3f} s; kept the last finite state")
+            q, v = x[: self._nv], x[self._nv :]
+            out = self._law(t, q, v)
+            if not self.hold_control:
+                x_next = np.concatenate(self._rk4_continuous(t, q, v, dt))
+            elif self.integrator == "rk4":
+                x_next = self.plant.rk4_state_step(x, out.tau, f, dt)
+            else:
+                x_next = np.concatenate(self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt))
+            if not (_all_finite(x_next) and _all_finite(out.tau)):
+                raise SimulationDiverged(_DIVERGED.format(t=t))
         self._layout.write(self.log.next_row(), t, x, out, f)
         self._x, self.t = x_next, t + dt
         self.last, self.last_force = out, f

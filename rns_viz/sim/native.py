@@ -1,0 +1,131 @@
+"""The native closed-loop step: a law of the paper and RK4 with the torque held, in one C++ call.
+
+``rns_viz._closed_loop`` (built from ``rns_viz/_native/closed_loop.cpp`` at install time when a C++
+compiler is there) computes, on the same pinocchio model:
+
+- :class:`~rns_viz.control.AccelerationLaw` (15) with :class:`~rns_viz.control.DampNullMotion` or
+  :class:`~rns_viz.control.TrackJointReference` as null-space input;
+- :class:`~rns_viz.control.VelocityLaw` (30) behind its velocity servo;
+
+then :meth:`~rns_viz.sim.plant.Plant.rk4_state_step`. :class:`~rns_viz.sim.Simulator` uses it for
+those laws when it is available. Gains, suppression, references and the force are read from the
+Python objects at every step, so changing them takes effect as before. Tests compare trajectories.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pinocchio  # noqa: F401  (loads the libraries the extension links, and registers pin.Model)
+
+from rns_viz.control import AccelerationLaw, ControlOutput, DampNullMotion, TrackJointReference, VelocityLaw
+from rns_viz.model import FsmsModel
+
+try:
+    from rns_viz import _closed_loop
+except ImportError as exc:  # not built (no compiler at install time) or built against other libraries
+    _closed_loop = None
+    _WHY: str | None = f"rns_viz._closed_loop did not import ({exc})"
+else:
+    _WHY = None
+
+
+LawArgs = tuple[Callable[..., float], tuple, np.ndarray | None]
+
+
+def available() -> bool:
+    return _closed_loop is not None
+
+
+def unavailable_reason() -> str | None:
+    """Why the native step is not available (None when it is)."""
+    return _WHY
+
+
+def supports(law: object) -> bool:
+    """The native step computes exactly this law (its type and its null-space input's type)."""
+    if type(law) is VelocityLaw:
+        return True
+    return type(law) is AccelerationLaw and type(law.null_input) in (DampNullMotion, TrackJointReference)
+
+
+class NativeStep:
+    """``(t, x, f_ext, dt) -> (x_next, ControlOutput)`` for one supported law; ``control(t, x)`` alone."""
+
+    def __init__(self, model: FsmsModel, law: AccelerationLaw | VelocityLaw) -> None:
+        if _closed_loop is None:
+            raise RuntimeError(_WHY)
+        if not supports(law):
+            raise ValueError(f"the native step does not compute {type(law).__name__}")
+        coupling = law.coupling
+        self.law = law
+        self._core = _closed_loop.ClosedLoop(
+            model.pin_model,
+            [int(i) for i in model.selected],
+            np.ascontiguousarray(model.K_b, dtype=float),
+            np.ascontiguousarray(model.D_b, dtype=float),
+            np.ascontiguousarray(model.D_m, dtype=float),
+            float(coupling.threshold),
+            float(coupling.max_damping),
+            bool(model.cb_is_hbm_dot),
+        )
+        self._nx, self._n, self._r = 2 * model.nv, model.n, len(model.selected)
+        self._no_force = np.zeros(model.m)
+        self._velocity = type(law) is VelocityLaw
+        self._law_args = self._velocity_args if self._velocity else self._composite_args
+        self._damped_step = self._core.damped_step
+
+    def __call__(
+        self, t: float, x: np.ndarray, f_ext: np.ndarray | None, dt: float
+    ) -> tuple[np.ndarray, ControlOutput] | None:
+        """x_next and the control; None when the law's null-space input changed to one computed in
+        Python only; FloatingPointError (nothing kept) when the step is not finite."""
+        x_next, tau, L = np.empty(self._nx), np.empty(self._n), np.empty(self._r)
+        f = self._no_force if f_ext is None else np.ascontiguousarray(f_ext, dtype=float)
+        law = self.law
+        if not self._velocity and type(law.null_input) is DampNullMotion:  # type: ignore[union-attr]
+            # the common case without a reference, kept short: this runs at every step
+            g_b = law.suppression_gain(t)  # type: ignore[union-attr]
+            sigma = self._damped_step(x, g_b, law.gains.g_m, law.null_input.g_m, f, dt, x_next, tau, L)  # type: ignore[union-attr]
+            return x_next, ControlOutput(tau, L, sigma)
+        law_args = self._law_args(t, control=False)
+        if law_args is None:
+            return None
+        step, args, theta_r = law_args
+        sigma = step(x, *args, f, dt, x_next, tau, L)
+        return x_next, ControlOutput(tau=tau, coupling_momentum=L, sigma_hbm=sigma, theta_ref=theta_r)
+
+    def control(self, t: float, x: np.ndarray) -> ControlOutput:
+        """The law alone at (t, x): what ``law(t, q, v)`` returns, computed natively."""
+        law_args = self._law_args(t, control=True)
+        if law_args is None:
+            raise ValueError(f"the native step does not compute {type(self.law.null_input).__name__}")  # type: ignore[union-attr]
+        control, args, theta_r = law_args
+        tau, L = np.empty(self._n), np.empty(self._r)
+        sigma = control(np.ascontiguousarray(x, dtype=float), *args, tau, L)
+        return ControlOutput(tau=tau, coupling_momentum=L, sigma_hbm=sigma, theta_ref=theta_r)
+
+    # The law's entry point, its arguments at time t (gains and references read now), theta_ref.
+    def _composite_args(self, t: float, control: bool) -> LawArgs | None:
+        law, core = self.law, self._core
+        g_b, g_m, null = law.suppression_gain(t), law.gains.g_m, law.null_input  # type: ignore[union-attr]
+        if type(null) is DampNullMotion:
+            return (core.damped_control if control else core.damped_step), (g_b, g_m, null.g_m), None
+        if type(null) is not TrackJointReference:
+            return None
+        theta_r, thetadot_r, thetaddot_r = (_vector(a) for a in null.reference(t))
+        args = (g_b, g_m, null.k_p, null.k_d, theta_r, thetadot_r, thetaddot_r)
+        return (core.tracking_control if control else core.tracking_step), args, theta_r
+
+    def _velocity_args(self, t: float, control: bool) -> LawArgs | None:
+        law, core = self.law, self._core
+        theta_r, thetadot_r, _ = law.reference(t)  # type: ignore[union-attr]
+        theta_r, thetadot_r = _vector(theta_r), _vector(thetadot_r)
+        g_b = law.gains.g_b if law.suppress and t >= law.suppress_after else 0.0  # type: ignore[union-attr]
+        args = (g_b, law.gains.g_m, law.gains.servo_bandwidth, law.feedforward, theta_r, thetadot_r)  # type: ignore[union-attr]
+        return (core.velocity_control if control else core.velocity_step), args, theta_r
+
+
+def _vector(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float)

@@ -1,0 +1,225 @@
+"""The native closed-loop step (C++) computes what the Python laws (15), (30) and RK4 compute.
+
+Trajectories with a kick, suppression switching on and gains changed mid-run agree to 1e-12, and so
+do the paper's presets run both ways; the laws alone agree at random states, at the TREP
+singularity, for a 2-DOF base with one or both rows selected (the SVD branch) and with gravity (the
+Coriolis branch of H_bm' theta'). CI sets RNS_VIZ_REQUIRE_NATIVE=1: a missing extension fails there.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rns_viz.control import (
+    AccelerationLaw,
+    DampNullMotion,
+    FixedReference,
+    Gains,
+    JointQuintic,
+    TorqueLaw,
+    TrackEndEffector,
+    TrackJointReference,
+    VelocityLaw,
+)
+from rns_viz.model import FsmsModel
+from rns_viz.scenarios import SCENARIOS, run_scenario
+from rns_viz.sim import ForcePulse, SimulationDiverged, Simulator, native
+
+if not native.available():
+    if os.environ.get("RNS_VIZ_REQUIRE_NATIVE") == "1":
+        raise RuntimeError(f"RNS_VIZ_REQUIRE_NATIVE=1 but {native.unavailable_reason()}")
+    pytest.skip(f"native step not built: {native.unavailable_reason()}", allow_module_level=True)
+
+RNG = np.random.default_rng(11)
+ASSETS = Path(__file__).resolve().parents[1] / "assets"
+
+
+def pair(model: FsmsModel, law: AccelerationLaw, **kw: object) -> tuple[Simulator, Simulator]:
+    """The same law and start in a native and a Python simulator."""
+    sims = (Simulator(model, law, native=True, **kw), Simulator(model, law, native=False, **kw))  # type: ignore[arg-type]
+    assert sims[0].native and not sims[1].native
+    return sims
+
+
+@pytest.mark.parametrize("name", ["trep", "planar3r"])
+def test_trajectories_agree(name: str) -> None:
+    model = FsmsModel.from_name(name)
+    law = AccelerationLaw(model, Gains(g_b=20.0, g_m=5.0), suppress_after=0.5)
+    kick = ForcePulse(0.1, 0.05, np.array([2.0 if name == "trep" else 20.0]))
+    sims = pair(model, law, force=kick)
+    for s in sims:
+        s.q = s.q + np.r_[1e-3, np.zeros(model.n)]
+        s.v = s.v + np.r_[0.0, np.full(model.n, 0.2)]
+    for s in sims:
+        s.run(1.0)
+    law.gains = Gains(g_b=5.0, g_m=1.0)  # read at every step by both
+    law.null_input = DampNullMotion(3.0)
+    for s in sims:
+        s.run(1.0)
+    native_log, python_log = (s.log.array() for s in sims)
+    assert abs(sims[0].q[0]) > 1e-6  # the base really moved
+    assert np.array_equal(np.isnan(native_log), np.isnan(python_log))
+    assert np.nanmax(np.abs(native_log - python_log)) <= 1e-12 * max(1.0, np.nanmax(np.abs(python_log)))
+    assert np.max(np.abs(sims[0]._x - sims[1]._x)) <= 1e-12
+
+
+def law_agrees(
+    model: FsmsModel, law: AccelerationLaw | VelocityLaw, q: np.ndarray, v: np.ndarray, t: float = 1.0
+) -> None:
+    step = native.NativeStep(model, law)
+    got = step.control(t, np.concatenate((q, v)))
+    want = law(t, q, v)
+    scale = max(1.0, float(np.max(np.abs(want.tau))))
+    assert np.allclose(got.tau, want.tau, rtol=0, atol=1e-10 * scale), (got.tau, want.tau)
+    assert np.allclose(got.coupling_momentum, want.coupling_momentum, rtol=1e-12, atol=1e-14)
+    assert math.isclose(got.sigma_hbm, want.sigma_hbm, rel_tol=1e-12, abs_tol=1e-14)
+    if want.theta_ref is None:
+        assert got.theta_ref is None
+    else:
+        assert np.array_equal(got.theta_ref, want.theta_ref)
+
+
+def random_laws(model: FsmsModel) -> list[AccelerationLaw | VelocityLaw]:
+    """One law of each natively computed kind, random gains, a random quintic joint reference."""
+    gains = Gains(
+        g_b=RNG.uniform(0, 50),
+        g_m=RNG.uniform(0, 30),
+        k_p=RNG.uniform(0, 500),
+        k_d=RNG.uniform(0, 50),
+        servo_bandwidth=RNG.uniform(10, 500),
+    )
+    theta0 = model.spec.default_configuration
+    reference = JointQuintic(theta0, theta0 + RNG.uniform(-1, 1, model.n), 2.0)
+    damped = AccelerationLaw(model, gains, DampNullMotion(RNG.uniform(0, 30)))
+    tracking = AccelerationLaw(model, gains, TrackJointReference(reference, gains.k_p, gains.k_d))
+    velocity = VelocityLaw(model, gains, reference, feedforward=bool(RNG.integers(2)))
+    return [damped, tracking, velocity]
+
+
+@pytest.mark.parametrize("name", ["trep", "planar3r"])
+def test_law_agrees_at_random_states(name: str) -> None:
+    model = FsmsModel.from_name(name)
+    for _ in range(30):
+        q = np.r_[RNG.normal(0, 1e-2, model.m), RNG.uniform(-math.pi, math.pi, model.n)]
+        v = RNG.normal(0, 1.0, model.nv)
+        for law in random_laws(model):
+            law_agrees(model, law, q, v, t=RNG.uniform(0, 3))
+
+
+def test_law_agrees_at_the_trep_singularity() -> None:
+    """Arm stretched along the base x axis: H_bm = 0, the damped inverse keeps both finite and equal."""
+    model = FsmsModel.from_name("trep")
+    for theta in ([0.0, 0.0], [math.pi, 0.0], [1e-9, -1e-9]):
+        for law in random_laws(model):
+            law_agrees(model, law, model.q(theta, [2e-3]), np.r_[0.05, 0.3, -0.2])
+
+
+XY_PARAMS = """
+[model]
+name = "xy3r"
+urdf = "xy3r.urdf"
+ee_frame = "ee"
+task_axes = ["x", "y"]
+default_configuration_deg = [60.0, -60.0, -60.0]
+gravity_m_per_s2 = {gravity}
+
+[base]
+joints = ["base_x", "base_y"]
+stiffness = [[100.0, 0.0], [0.0, 150.0]]
+damping = [[0.1, 0.0], [0.0, 0.2]]
+selection = {selection}
+
+[arm]
+joint_damping = [0.01, 0.02, 0.03]
+"""
+
+
+def xy_model(tmp_path: Path, selection: list[int], gravity: list[float]) -> FsmsModel:
+    """The bundled planar 3R on a cart that deflects along x and y (a 2-DOF base)."""
+    urdf = (ASSETS / "planar3r.urdf").read_text()
+    sled = (
+        '<link name="sled"><inertial><mass value="0.5"/>'
+        '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>\n'
+        '  <joint name="base_x" type="prismatic"><parent link="world"/><child link="sled"/>'
+        '<axis xyz="1 0 0"/><limit lower="-2" upper="2" effort="1000" velocity="10"/></joint>\n'
+        '  <joint name="base_y" type="prismatic"><parent link="sled"/><child link="cart"/>'
+        '<axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1000" velocity="10"/></joint>'
+    )
+    start = urdf.index('<joint name="base_x"')
+    end = urdf.index("</joint>", start) + len("</joint>")
+    (tmp_path / "xy3r.urdf").write_text(urdf[:start] + sled + urdf[end:])
+    params = tmp_path / "xy3r.toml"
+    params.write_text(XY_PARAMS.format(selection=selection, gravity=gravity))
+    return FsmsModel.from_file(params)
+
+
+@pytest.mark.parametrize(
+    ("selection", "gravity"),
+    [([1, 1], [0.0, 0.0, 0.0]), ([1, 0], [0.0, 0.0, 0.0]), ([1, 1], [0.0, -9.81, 0.0])],
+    ids=["both-rows", "x-row-only", "gravity"],
+)
+def test_two_dof_base(tmp_path: Path, selection: list[int], gravity: list[float]) -> None:
+    model = xy_model(tmp_path, selection, gravity)
+    assert model.m == 2 and len(model.selected) == sum(selection)
+    assert model.cb_is_hbm_dot == (not any(gravity))
+    for _ in range(20):
+        q = np.r_[RNG.normal(0, 1e-2, 2), RNG.uniform(-math.pi, math.pi, 3)]
+        v = RNG.normal(0, 1.0, model.nv)
+        for law in random_laws(model):
+            law_agrees(model, law, q, v)
+    law = AccelerationLaw(model, Gains(g_b=10.0, g_m=2.0))
+    sims = pair(model, law, force=ForcePulse(0.05, 0.05, np.array([10.0, -5.0])))
+    for s in sims:
+        s.run(0.5)
+    assert np.max(np.abs(sims[0]._x - sims[1]._x)) <= 1e-11
+
+
+def test_other_laws_stay_in_python() -> None:
+    model = FsmsModel.from_name("planar3r")
+    gains = Gains(g_b=10.0, g_m=1.0)
+    law = AccelerationLaw(model, gains)
+    sims = pair(model, law)
+    for s in sims:
+        s.run(0.2)
+    # The null input changes in place to one computed in Python only: the native simulator falls
+    # back to Python for those steps and both runs stay together.
+    target = FixedReference(model.ee_position(model.spec.default_configuration)[:2] + 0.05)
+    law.null_input = TrackEndEffector(model, target, 25.0, 10.0)
+    for s in sims:
+        s.run(0.2)
+    assert np.max(np.abs(sims[0]._x - sims[1]._x)) <= 1e-12
+    sims[0].law = law  # re-checked when the law is set
+    assert not sims[0].native
+    assert not Simulator(model, TorqueLaw(model, gains)).native
+    assert not Simulator(model, AccelerationLaw(model, gains), integrator="semi-implicit-euler").native
+    assert not Simulator(model, AccelerationLaw(model, gains), hold_control=False).native
+
+
+@pytest.mark.parametrize("name", sorted(SCENARIOS))
+def test_presets_agree(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every preset run natively and in Python gives the same log (laws not computed natively
+    run in Python both times)."""
+    duration = min(SCENARIOS[name].duration, 4.0)
+    fast = run_scenario(name, duration)
+    monkeypatch.setattr(native, "available", lambda: False)
+    slow = run_scenario(name, duration)
+    assert not slow.native
+    a, b = fast.log.array(), slow.log.array()
+    assert a.shape == b.shape
+    assert np.allclose(a, b, rtol=1e-10, atol=1e-13, equal_nan=True), np.nanmax(np.abs(a - b))
+
+
+def test_divergence_keeps_the_last_finite_state() -> None:
+    model = FsmsModel.from_name("trep")
+    law = AccelerationLaw(model, Gains(g_b=24.0, g_m=20.0))
+    sim = Simulator(model, law)
+    sim.v = np.r_[0.0, 1e200, -1e200]  # the next step overflows
+    x_before = sim._x.copy()
+    with pytest.raises(SimulationDiverged, match="non-finite"):
+        sim.step()
+    assert np.array_equal(sim._x, x_before, equal_nan=True) and sim.t == 0.0
