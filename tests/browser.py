@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import pytest
 import viser
@@ -50,6 +51,12 @@ def wait_until(condition: Callable[[], object], timeout: float, what: str, poll:
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out after {timeout} s waiting for {what}")
         time.sleep(poll)
+
+
+def wait_for_clients(app: Any, count: int, what: str, timeout: float = 10.0) -> None:
+    """Wait until ``count`` clients are connected AND the app's connect handler has registered them
+    with the operator lock (viser lists a client before its connect callbacks have run)."""
+    wait_until(lambda: len(app.server.get_clients()) == count and len(app.lock.clients()) == count, timeout, what)
 
 
 @contextmanager

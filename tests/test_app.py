@@ -20,7 +20,7 @@ from rns_viz.control import InvalidGain
 from rns_viz.session import Session
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, serve, start_app
 from rns_viz.viz.scene import FsmsScene
-from tests.browser import wait_until
+from tests.browser import wait_for_clients, wait_until
 from tests.ws_client import WsClient
 
 
@@ -44,7 +44,7 @@ def planar_app() -> Iterator[RnsApp]:
 def client(request: pytest.FixtureRequest) -> Iterator[WsClient]:
     app: RnsApp = request.getfixturevalue(request.param)
     ws = WsClient(app.port)
-    wait_until(lambda: len(app.server.get_clients()) == 1, 10.0, "the websocket client to connect")
+    wait_for_clients(app, 1, "the websocket client to connect")
     yield ws
     ws.close()
 
@@ -73,7 +73,7 @@ def test_binds_localhost_by_default_and_reports_its_port(trep_app: RnsApp) -> No
     assert inspect.signature(serve).parameters["port"].default == 8080
     assert trep_app.port > 0
     ws = WsClient(trep_app.port)
-    wait_until(lambda: len(trep_app.server.get_clients()) == 1, 10.0, "a client")
+    wait_for_clients(trep_app, 1, "a client")
     ws.close()
 
 
@@ -354,12 +354,12 @@ def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: WsCli
     ee = trep_app.model.ee_position(s.snapshot().q[1:])
     client.drag(TARGET_HANDLE, (ee[0] + 0.02, ee[1], ee[2]), "start")
     client.close()  # gone without a drag end
-    wait_until(lambda: len(trep_app.server.get_clients()) == 0, 10.0, "the client to disconnect")
+    wait_for_clients(trep_app, 0, "the client to disconnect")
     s.advance(1.0)
     assert not s.snapshot().paused and s.snapshot().t > 0.9
     other = WsClient(trep_app.port)
     try:
-        wait_until(lambda: len(trep_app.server.get_clients()) == 1, 10.0, "a new client")
+        wait_for_clients(trep_app, 1, "a new client")
         other.click(uuid(trep_app.gui.kick))
         queued(trep_app, "kick")
     finally:
@@ -389,7 +389,7 @@ def test_with_a_password_unknown_clients_only_watch() -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False, password="s3cret")
     ws = WsClient(app.port)
     try:
-        wait_until(lambda: len(app.server.get_clients()) == 1, 10.0, "a client")
+        wait_for_clients(app, 1, "a client")
         ws.click(uuid(app.gui.kick))
         wait_until(lambda: ws.types["NotificationShowMessage"] >= 1, 10.0, "the 'View only' notice")
         assert app.session.pending_commands() == []

@@ -60,10 +60,12 @@ def churn_process(port: int, seconds: float) -> None:
 
 
 def new_client(app: object, port: int) -> tuple[ProtocolClient, int]:
+    """A connected client, once the server's connect handler has registered it with the lock."""
     before = set(app.server.get_clients())  # type: ignore[attr-defined]
     c = ProtocolClient(port)
     wait_until(lambda: set(app.server.get_clients()) - before, 10.0, "the client to register")  # type: ignore[attr-defined]
     (cid,) = set(app.server.get_clients()) - before  # type: ignore[attr-defined]
+    wait_until(lambda: cid in app.lock.clients(), 10.0, "the connect handler to run")  # type: ignore[attr-defined]
     return c, cid
 
 

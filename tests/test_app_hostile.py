@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
 from rns_viz.viz.gui import GuiElements
-from tests.browser import wait_until
+from tests.browser import wait_for_clients
 from tests.protocol_client import ProtocolClient, gui_uuid
 
 EXAMPLES = 40  # per model: ~15 s each
@@ -57,9 +57,9 @@ def hostile_app(request: pytest.FixtureRequest) -> Iterator[tuple[RnsApp, Protoc
     app = start_app(request.param, port=0, realtime=False, verbose=False)
     assert app.session.wait_background()
     operator = ProtocolClient(app.port)
-    wait_until(lambda: len(app.server.get_clients()) == 1, 10.0, "the operator's client")
+    wait_for_clients(app, 1, "the operator's client")
     watcher = ProtocolClient(app.port)
-    wait_until(lambda: len(app.server.get_clients()) == 2, 10.0, "a watcher")
+    wait_for_clients(app, 2, "a watcher")
     assert app.lock.operator is not None
     yield app, operator, watcher
     for c in (operator, watcher):
@@ -142,7 +142,7 @@ def test_afterwards_the_app_is_alive(hostile_app: tuple[RnsApp, ProtocolClient, 
     assert app._thread.is_alive() and s.worker._thread.is_alive()
     late = ProtocolClient(app.port)
     try:
-        wait_until(lambda: len(app.server.get_clients()) == 3, 10.0, "a new client to connect")
+        wait_for_clients(app, 3, "a new client to connect")
     finally:
         late.close()
     s.reset()

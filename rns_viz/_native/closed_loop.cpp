@@ -1,8 +1,9 @@
 // One closed-loop step of an FSMS in C++: a control law of the paper realised by resolved
 // acceleration (Fig. 1), then one RK4 step of the plant with that torque held (a digital controller).
-// Laws: the composite law, Eq. (15), with the null-space input u = -G_u theta' (Fig. 3) or
-// u = theta_r'' + k_d (theta_r' - theta') + k_p (theta_r - theta); and the velocity-command law,
-// Eq. (30), behind a velocity servo theta'' = w_s (theta'_cmd - theta').
+// Laws: the composite law, Eq. (15), with the null-space input u = -G_u theta' (Fig. 3),
+// u = theta_r'' + k_d (theta_r' - theta') + k_p (theta_r - theta), or reactionless end-effector
+// tracking, Eq. (24); and the velocity-command law, Eq. (30), behind a velocity servo
+// theta'' = w_s (theta'_cmd - theta').
 //
 // The same arithmetic as rns_viz.control (AccelerationLaw, VelocityLaw) and
 // rns_viz.sim.Plant.rk4_state_step; the tests compare trajectories to 1e-12. Dynamics only through
@@ -10,13 +11,15 @@
 // from URDF: no inertia by hand. References theta_r(t) are evaluated in Python and passed in.
 //
 // Python: _closed_loop.ClosedLoop(pin_model, rows, K_b, D_b, D_m, threshold, max_damping,
-// cb_is_hbm_dot). Each *_step writes the next state, the torque and the coupling momentum into the
+// cb_is_hbm_dot, ee_frame_id, base_joint_id, task_rows). Each *_step writes the next state, the torque and the coupling momentum into the
 // given float64 arrays and returns sigma_min(S H_bm) (FloatingPointError when they are not finite);
 // each *_control computes the law alone.
 
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 
 #include <Eigen/Dense>
@@ -48,10 +51,15 @@ double damping_squared(double sigma, double threshold, double max_damping) {
 class ClosedLoop {
  public:
   ClosedLoop(const Model& model, const std::vector<int>& rows, const MatrixXd& K_b, const MatrixXd& D_b,
-                const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot)
+                const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot, int ee_frame,
+                int base_joint, const std::vector<int>& task_rows)
       : model_(model),
         law_data_(model),
         plant_data_(model),
+        task_data_(model),
+        ee_frame_(ee_frame),
+        base_joint_(base_joint),
+        task_rows_(task_rows),
         rows_(rows),
         K_(K_b),
         D_(D_b),
@@ -69,6 +77,10 @@ class ClosedLoop {
       throw std::invalid_argument("K_b, D_b (m x m), D_m (n x n) and 1..m selected rows must fit the model");
     for (int i : rows)
       if (i < 0 || i >= m_) throw std::invalid_argument("a selected row is not a base row");
+    if (ee_frame < 0 || ee_frame >= static_cast<int>(model.nframes) || base_joint < 1 || base_joint >= model.njoints)
+      throw std::invalid_argument("the end-effector frame or the base joint is not in the model");
+    for (int i : task_rows)
+      if (i < 0 || i > 2) throw std::invalid_argument("task rows are 0 (x), 1 (y) or 2 (z)");
     arm_damped_ = Dm_.cwiseAbs().maxCoeff() > 0.0;
     u_.setZero(nv_);
     stage_.setZero(2 * nv_);
@@ -101,6 +113,58 @@ class ClosedLoop {
     const double sigma = tracking_control(x, g_b, g_m, k_p, k_d, theta_r, thetadot_r, thetaddot_r, tau, L);
     advance(x, tau, f_ext, dt, x_next);
     return sigma;
+  }
+
+  // Eq. (15) with Eq. (24): P u = J-bar^+ [x_d'' + G_d e' + G_p e - J' theta' + J H_bm^+ H_bm' theta'],
+  // e = x_d - x_e, J-bar = J P_RNS with the damped inverse (threshold = max damping, m/rad).
+  // Returns (sigma_min(S H_bm), sigma_min(J-bar)).
+  bp::tuple task_control(const ConstRef& x, double g_b, double g_m, double G_p, double G_d, double threshold,
+                         const ConstRef& x_d, const ConstRef& xdot_d, const ConstRef& xddot_d, Ref tau, Ref L) {
+    check_sizes(x, tau, L);
+    const Index p = static_cast<Index>(task_rows_.size());
+    if (p == 0 || x_d.size() != p || xdot_d.size() != p || xddot_d.size() != p)
+      throw std::invalid_argument("the target has one entry per task axis");
+    const auto q = x.head(nv_);
+    const auto v = x.tail(nv_);
+    const double sigma = coupling(q, v, L);
+    const auto thetadot = v.tail(n_);
+    // J, J' theta' and x_e relative to and in the base frame (rns_viz.model.FsmsModel.ee_kinematics)
+    VectorXd v_rel = VectorXd::Zero(nv_);
+    v_rel.tail(n_) = thetadot;
+    pinocchio::forwardKinematics(model_, task_data_, q, v_rel, VectorXd::Zero(nv_));
+    pinocchio::updateFramePlacement(model_, task_data_, ee_frame_);
+    const Eigen::Matrix3d R = task_data_.oMi[base_joint_].rotation();
+    const Eigen::Vector3d ee =
+        R.transpose() * (task_data_.oMf[ee_frame_].translation() - task_data_.oMi[base_joint_].translation());
+    const Eigen::Vector3d acc =
+        R.transpose() *
+        pinocchio::getFrameClassicalAcceleration(model_, task_data_, ee_frame_, pinocchio::LOCAL_WORLD_ALIGNED).linear();
+    MatrixXd J6 = MatrixXd::Zero(6, nv_);
+    pinocchio::computeFrameJacobian(model_, task_data_, q, ee_frame_, pinocchio::LOCAL_WORLD_ALIGNED, J6);
+    const MatrixXd J_base = R.transpose() * J6.topRows(3).rightCols(n_);
+    MatrixXd J(p, n_);
+    VectorXd Jdot_thetadot(p), e(p);
+    for (Index i = 0; i < p; ++i) {
+      J.row(i) = J_base.row(task_rows_[i]);
+      Jdot_thetadot(i) = acc(task_rows_[i]);
+      e(i) = x_d(i) - ee(task_rows_[i]);
+    }
+    const VectorXd edot = xdot_d - J * thetadot;
+    const MatrixXd J_bar = J * (MatrixXd::Identity(n_, n_) - pinv_ * H_bm_);
+    const double sigma_jbar = Eigen::JacobiSVD<MatrixXd>(J_bar).singularValues()(std::min(p, n_) - 1);
+    const double lam2 = damping_squared(sigma_jbar, threshold, threshold);
+    const MatrixXd G = J_bar * J_bar.transpose() + lam2 * MatrixXd::Identity(p, p);
+    const VectorXd rhs = xddot_d + G_d * edot + G_p * e - Jdot_thetadot + J * (pinv_ * hbm_dot_s_);
+    const VectorXd Pu = J_bar.transpose() * G.partialPivLu().solve(rhs);
+    realize(q, v, pinv_ * (g_b * (H_b_ * xdot_b_) - hbm_dot_s_ - g_m * L) + Pu, tau);
+    return bp::make_tuple(sigma, sigma_jbar);
+  }
+  bp::tuple task_step(const ConstRef& x, double g_b, double g_m, double G_p, double G_d, double threshold,
+                      const ConstRef& x_d, const ConstRef& xdot_d, const ConstRef& xddot_d, const ConstRef& f_ext,
+                      double dt, Ref x_next, Ref tau, Ref L) {
+    bp::tuple sigmas = task_control(x, g_b, g_m, G_p, G_d, threshold, x_d, xdot_d, xddot_d, tau, L);
+    advance(x, tau, f_ext, dt, x_next);
+    return sigmas;
   }
 
   // Eq. (30): theta'_cmd = H_bm^+ H_b g_b x_b + g_m (theta_r - theta) [+ theta_r'], then the servo.
@@ -251,7 +315,9 @@ class ClosedLoop {
   }
 
   Model model_;
-  Data law_data_, plant_data_;
+  Data law_data_, plant_data_, task_data_;
+  int ee_frame_, base_joint_;
+  std::vector<int> task_rows_;
   std::vector<int> rows_;
   MatrixXd K_, D_, Dm_;
   double threshold_, max_damping_;
@@ -270,8 +336,10 @@ std::vector<int> int_list(const bp::object& seq) {
 }
 
 ClosedLoop* make_closed_loop(const Model& model, const bp::object& rows, const MatrixXd& K_b, const MatrixXd& D_b,
-                         const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot) {
-  return new ClosedLoop(model, int_list(rows), K_b, D_b, D_m, threshold, max_damping, cb_is_hbm_dot);
+                             const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot, int ee_frame,
+                             int base_joint, const bp::object& task_rows) {
+  return new ClosedLoop(model, int_list(rows), K_b, D_b, D_m, threshold, max_damping, cb_is_hbm_dot, ee_frame,
+                        base_joint, int_list(task_rows));
 }
 
 void translate(const std::invalid_argument& e) { PyErr_SetString(PyExc_ValueError, e.what()); }
@@ -290,6 +358,8 @@ BOOST_PYTHON_MODULE(_closed_loop) {
       .def("damped_step", &ClosedLoop::damped_step)
       .def("tracking_control", &ClosedLoop::tracking_control)
       .def("tracking_step", &ClosedLoop::tracking_step)
+      .def("task_control", &ClosedLoop::task_control)
+      .def("task_step", &ClosedLoop::task_step)
       .def("velocity_control", &ClosedLoop::velocity_control)
       .def("velocity_step", &ClosedLoop::velocity_step);
 }

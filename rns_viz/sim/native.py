@@ -3,8 +3,9 @@
 ``rns_viz._closed_loop`` (built from ``rns_viz/_native/closed_loop.cpp`` at install time when a C++
 compiler is there) computes, on the same pinocchio model:
 
-- :class:`~rns_viz.control.AccelerationLaw` (15) with :class:`~rns_viz.control.DampNullMotion` or
-  :class:`~rns_viz.control.TrackJointReference` as null-space input;
+- :class:`~rns_viz.control.AccelerationLaw` (15) with :class:`~rns_viz.control.DampNullMotion`,
+  :class:`~rns_viz.control.TrackJointReference` or :class:`~rns_viz.control.TrackEndEffector`
+  (Eq. 24) as null-space input (by its ``native_kind``);
 - :class:`~rns_viz.control.VelocityLaw` (30) behind its velocity servo;
 
 then :meth:`~rns_viz.sim.plant.Plant.rk4_state_step`. :class:`~rns_viz.sim.Simulator` uses it for
@@ -19,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 import pinocchio  # noqa: F401  (loads the libraries the extension links, and registers pin.Model)
 
-from rns_viz.control import AccelerationLaw, ControlOutput, DampNullMotion, TrackJointReference, VelocityLaw
+from rns_viz.control import AccelerationLaw, ControlOutput, DampNullMotion, VelocityLaw
 from rns_viz.model import FsmsModel
 
 try:
@@ -31,7 +32,8 @@ else:
     _WHY = None
 
 
-LawArgs = tuple[Callable[..., float], tuple, np.ndarray | None]
+Ref = np.ndarray | None  # theta_ref, or ee_ref (the target x_d) for Eq. (24)
+LawArgs = tuple[Callable[..., float | tuple[float, float]], tuple, Ref]
 
 
 def available() -> bool:
@@ -43,11 +45,18 @@ def unavailable_reason() -> str | None:
     return _WHY
 
 
+NULL_KINDS = ("damp", "joint", "task")  # the null-space inputs computed natively (their native_kind)
+
+
 def supports(law: object) -> bool:
-    """The native step computes exactly this law (its type and its null-space input's type)."""
+    """The native step computes exactly this law (its type and its null-space input's kind)."""
     if type(law) is VelocityLaw:
         return True
-    return type(law) is AccelerationLaw and type(law.null_input) in (DampNullMotion, TrackJointReference)
+    return type(law) is AccelerationLaw and _null_kind(law) in NULL_KINDS
+
+
+def _null_kind(law: AccelerationLaw) -> str | None:
+    return getattr(type(law.null_input), "native_kind", None)
 
 
 class NativeStep:
@@ -69,6 +78,9 @@ class NativeStep:
             float(coupling.threshold),
             float(coupling.max_damping),
             bool(model.cb_is_hbm_dot),
+            int(model.ee_frame_id),
+            int(model.base_joint_id),
+            [int(i) for i in model.task_rows],
         )
         self._nx, self._n, self._r = 2 * model.nv, model.n, len(model.selected)
         self._no_force = np.zeros(model.m)
@@ -92,27 +104,36 @@ class NativeStep:
         law_args = self._law_args(t, control=False)
         if law_args is None:
             return None
-        step, args, theta_r = law_args
-        sigma = step(x, *args, f, dt, x_next, tau, L)
-        return x_next, ControlOutput(tau=tau, coupling_momentum=L, sigma_hbm=sigma, theta_ref=theta_r)
+        step, args, ref = law_args
+        return x_next, self._output(step(x, *args, f, dt, x_next, tau, L), tau, L, ref)
 
     def control(self, t: float, x: np.ndarray) -> ControlOutput:
         """The law alone at (t, x): what ``law(t, q, v)`` returns, computed natively."""
         law_args = self._law_args(t, control=True)
         if law_args is None:
             raise ValueError(f"the native step does not compute {type(self.law.null_input).__name__}")  # type: ignore[union-attr]
-        control, args, theta_r = law_args
+        control, args, ref = law_args
         tau, L = np.empty(self._n), np.empty(self._r)
-        sigma = control(np.ascontiguousarray(x, dtype=float), *args, tau, L)
-        return ControlOutput(tau=tau, coupling_momentum=L, sigma_hbm=sigma, theta_ref=theta_r)
+        return self._output(control(np.ascontiguousarray(x, dtype=float), *args, tau, L), tau, L, ref)
+
+    def _output(self, sigmas: float | tuple[float, float], tau: np.ndarray, L: np.ndarray, ref: Ref) -> ControlOutput:
+        """The ControlOutput of a native call: sigma(s) as returned, theta_ref or ee_ref as passed in."""
+        if isinstance(sigmas, tuple):  # Eq. (24): sigma of S H_bm and of J-bar; ref is the target
+            return ControlOutput(tau, L, sigmas[0], sigma_jbar=sigmas[1], ee_ref=ref)
+        return ControlOutput(tau, L, sigmas, theta_ref=ref)
 
     # The law's entry point, its arguments at time t (gains and references read now), theta_ref.
     def _composite_args(self, t: float, control: bool) -> LawArgs | None:
         law, core = self.law, self._core
         g_b, g_m, null = law.suppression_gain(t), law.gains.g_m, law.null_input  # type: ignore[union-attr]
-        if type(null) is DampNullMotion:
+        kind = _null_kind(law)  # type: ignore[arg-type]
+        if kind == "damp":
             return (core.damped_control if control else core.damped_step), (g_b, g_m, null.g_m), None
-        if type(null) is not TrackJointReference:
+        if kind == "task":
+            x_d, xdot_d, xddot_d = (_vector(a) for a in null.target(t))
+            args = (g_b, g_m, null.G_p, null.G_d, null.threshold, x_d, xdot_d, xddot_d)
+            return (core.task_control if control else core.task_step), args, x_d
+        if kind != "joint":
             return None
         theta_r, thetadot_r, thetaddot_r = (_vector(a) for a in null.reference(t))
         args = (g_b, g_m, null.k_p, null.k_d, theta_r, thetadot_r, thetaddot_r)
