@@ -10,7 +10,7 @@ its threads); clients run in this process. Scenarios, each with the shadow run o
 
 1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
    its reactionless path; 3R: kicks) and the base is kicked every 5 s from the page's button;
-2. four protocol-level websocket clients (tests/ws_client.py), decoding everything they receive;
+2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
 
@@ -160,13 +160,13 @@ def scenario_browser(model: str, seconds: float) -> None:
 
 
 def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
-    from tests.ws_client import WsClient
+    from tests.protocol_client import ProtocolClient
 
     srv = Server(model)
-    clients: list[WsClient] = []
+    clients: list[ProtocolClient] = []
     stop = threading.Event()
     try:
-        clients = [WsClient(srv.info["port"]) for _ in range(count)]
+        clients = [ProtocolClient(srv.info["port"], decode=True) for _ in range(count)]
         time.sleep(2.0)
         if model == "trep":
             clients[0].click(srv.info["cyclic"])
@@ -188,12 +188,12 @@ def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
 
 
 def scenario_latency(model: str, seconds: float) -> None:
-    from tests.ws_client import WsClient
+    from tests.protocol_client import ProtocolClient
 
     srv = Server(model)
     ws = None
     try:
-        ws = WsClient(srv.info["port"], decode=False)
+        ws = ProtocolClient(srv.info["port"], decode=False)
         time.sleep(2.0)
         ee = srv.stats()["ee"]
         srv.stats()  # clear the latencies so far

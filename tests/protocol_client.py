@@ -1,28 +1,42 @@
 """A protocol-level viser client: speaks the websocket protocol like a browser tab, without one.
 
 It connects with the subprotocol ``viser-v<version>``, sends client->server messages exactly as
-the browser does (msgpack dicts built by viser's own message classes: GUI updates, transform
-drags) and drains what the server sends on a background thread, counting messages and bytes.
-Used by load, latency and robustness tests; only connects to loopback addresses.
+the browser does (msgpack dicts built by viser's own message classes: camera reports, GUI updates,
+transform drags) and drains what the server sends on a background thread, counting messages and
+bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack windows and
+counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
+element (update rates for benchmarks). Only connects to loopback addresses (DESIGN.md section 8).
 """
 
 from __future__ import annotations
 
 import threading
 import time
+from collections import Counter
 from typing import Any
 
 import msgspec.msgpack
 import viser
+import zstandard
 from viser import _messages
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
+
+_SCENE_POSE = ("SetPositionMessage", "SetOrientationMessage")
+_IDENTITY = (1.0, 0.0, 0.0, 0.0)
 
 
 class ProtocolClient:
     """One simulated browser tab connected to a local viser server."""
 
-    def __init__(self, port: int, host: str = "127.0.0.1", timeout: float = 10.0) -> None:
+    def __init__(
+        self,
+        port: int,
+        host: str = "127.0.0.1",
+        timeout: float = 20.0,
+        decode: bool = False,
+        watch_node: str = "/base",
+    ) -> None:
         if not (host.startswith("127.") or host in ("localhost", "::1")):
             raise ValueError("protocol clients only connect to this machine")
         self._ws: ClientConnection = connect(
@@ -31,15 +45,29 @@ class ProtocolClient:
             open_timeout=timeout,
             max_size=None,
         )
-        self.messages = 0
+        self.decode = decode
+        self.watch_node = watch_node
+        self.messages = 0  # frames received
         self.bytes = 0
         self.last_message_time = 0.0
+        self.types: Counter[str] = Counter()  # decoded message type -> count
+        self.nodes: Counter[str] = Counter()  # scene node name -> messages that touched it
+        self.gui_updates: Counter[str] = Counter()  # GUI element uuid -> GuiUpdateMessages
+        self.pose_times: list[float] = []  # perf_counter times of windows that moved ``watch_node``
+        self.gui_times: dict[str, list[float]] = {}  # uuid -> perf_counter times of its updates
         self.closed = threading.Event()
+        self._zstd = zstandard.ZstdDecompressor()
         self._lock = threading.Lock()
         self._reader = threading.Thread(target=self._drain, daemon=True)
         self._reader.start()
         # viser registers a client (get_clients, on_client_connect) at its first camera message.
-        self.camera((0.0, 0.0, 0.0, 1.0), (0.5, 0.5, 0.5))
+        self.camera(_IDENTITY, (0.5, 0.5, 0.5))
+
+    # -- sending -------------------------------------------------------------------------------
+    def _send(self, message: _messages.Message) -> None:
+        payload = msgspec.msgpack.encode(message.as_serializable_dict())
+        with self._lock:
+            self._ws.send(payload)
 
     def camera(self, wxyz: tuple[float, ...], position: tuple[float, float, float]) -> None:
         """A viewer camera report, as the browser sends when it starts and when the view moves."""
@@ -57,29 +85,32 @@ class ProtocolClient:
             )
         )
 
-    def _drain(self) -> None:
-        try:
-            for frame in self._ws:
-                self.messages += 1
-                self.bytes += len(frame)
-                self.last_message_time = time.monotonic()
-        except (ConnectionClosed, OSError):
-            pass
-        finally:
-            self.closed.set()
-
-    def _send(self, message: _messages.Message) -> None:
-        payload = msgspec.msgpack.encode(message.as_serializable_dict())
-        with self._lock:
-            self._ws.send(payload)
-
     def gui_update(self, uuid: str, **updates: Any) -> None:
         """What the browser sends when a control changes (value=..., or value=True for a click)."""
         self._send(_messages.GuiUpdateMessage(uuid, updates))
 
-    def drag(self, name: str, position: tuple[float, float, float], wxyz: tuple[float, ...] = (1.0, 0, 0, 0)) -> None:
-        """A transform-controls drag event on scene node ``name`` (position in the parent frame)."""
-        self._send(_messages.TransformControlsUpdateMessage(name, tuple(wxyz), tuple(position)))  # type: ignore[arg-type]
+    def set_value(self, uuid: str, value: Any) -> None:
+        """A slider, checkbox, text field or dropdown changed."""
+        self.gui_update(uuid, value=value)
+
+    def click(self, uuid: str, value: Any = True) -> None:
+        """A button click (a button group sends the clicked option as the value)."""
+        self.gui_update(uuid, value=value)
+
+    def drag(
+        self,
+        name: str,
+        position: tuple[float, float, float],
+        phase: str = "update",
+        wxyz: tuple[float, ...] = _IDENTITY,
+    ) -> None:
+        """A transform-controls drag event on scene node ``name`` (position in the parent frame);
+        phase "start" and "end" also send the drag start/end markers around it."""
+        if phase == "start":
+            self.drag_phase(name, "start")
+        self._send(_messages.TransformControlsUpdateMessage(name, tuple(wxyz), tuple(float(x) for x in position)))  # type: ignore[arg-type]
+        if phase == "end":
+            self.drag_phase(name, "end")
 
     def drag_phase(self, name: str, phase: str) -> None:
         """Drag start/end markers (viser's TransformControlsDragStart/EndMessage) if this viser has them."""
@@ -88,6 +119,50 @@ class ProtocolClient:
         if message_type is not None:
             self._send(message_type(name))
 
+    # -- receiving -----------------------------------------------------------------------------
+    def _drain(self) -> None:
+        try:
+            for frame in self._ws:
+                now = time.perf_counter()
+                self.messages += 1
+                self.bytes += len(frame)
+                self.last_message_time = time.monotonic()
+                if self.decode and isinstance(frame, bytes):
+                    self._count(frame, now)
+        except (ConnectionClosed, OSError):
+            pass
+        finally:
+            self.closed.set()
+
+    def _count(self, frame: bytes, now: float) -> None:
+        """Count the messages of one server window: 8-byte size, 8-byte compressed size, zstd msgpack."""
+        size = int.from_bytes(frame[0:8], "little")
+        compressed = int.from_bytes(frame[8:16], "little")
+        window = msgspec.msgpack.decode(self._zstd.decompress(frame[16 : 16 + compressed], max_output_size=size))
+        moved = False
+        for msg in window["messages"]:
+            kind = msg.get("type", "?")
+            self.types[kind] += 1
+            if "name" in msg:
+                self.nodes[msg["name"]] += 1
+            if kind in _SCENE_POSE and msg.get("name") == self.watch_node:
+                moved = True
+            elif kind == "GuiUpdateMessage":
+                uuid = msg.get("uuid", "")
+                self.gui_updates[uuid] += 1
+                self.gui_times.setdefault(uuid, []).append(now)
+        if moved:
+            self.pose_times.append(now)
+
+    @staticmethod
+    def rate(times: list[float], since: float) -> float:
+        """Events per second in ``times`` after ``since`` (perf_counter seconds)."""
+        recent = [t for t in times if t >= since]
+        if len(recent) < 2:
+            return 0.0
+        return (len(recent) - 1) / (recent[-1] - recent[0])
+
+    # -- ending --------------------------------------------------------------------------------
     def close(self) -> None:
         self._ws.close()
         self.closed.wait(5.0)

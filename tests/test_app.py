@@ -1,7 +1,7 @@
 """The live app, headless: a real viser server on 127.0.0.1, driven like a browser would drive it.
 
 Inputs go through the app's own GUI handles and scene handle, either set on the server or sent by
-a protocol-level websocket client (tests/ws_client.py), so viser's real callback path runs. The
+a protocol-level websocket client (tests/protocol_client.py), so viser's real callback path runs. The
 session is made with ``realtime=False`` and advanced faster than real time with ``advance()``;
 one test checks the wall-clock pacing itself.
 """
@@ -21,7 +21,8 @@ from rns_viz.session import Session
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, serve, start_app
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import wait_for_clients, wait_until
-from tests.ws_client import WsClient
+from tests.protocol_client import ProtocolClient
+from tests.test_scenarios import PAPER_PRESETS
 
 
 @pytest.fixture
@@ -41,9 +42,9 @@ def planar_app() -> Iterator[RnsApp]:
 
 
 @pytest.fixture
-def client(request: pytest.FixtureRequest) -> Iterator[WsClient]:
+def client(request: pytest.FixtureRequest) -> Iterator[ProtocolClient]:
     app: RnsApp = request.getfixturevalue(request.param)
-    ws = WsClient(app.port)
+    ws = ProtocolClient(app.port, decode=True)
     wait_for_clients(app, 1, "the websocket client to connect")
     yield ws
     ws.close()
@@ -72,7 +73,7 @@ def test_binds_localhost_by_default_and_reports_its_port(trep_app: RnsApp) -> No
     assert inspect.signature(serve).parameters["host"].default == "127.0.0.1"
     assert inspect.signature(serve).parameters["port"].default == 8080
     assert trep_app.port > 0
-    ws = WsClient(trep_app.port)
+    ws = ProtocolClient(trep_app.port, decode=True)
     wait_for_clients(trep_app, 1, "a client")
     ws.close()
 
@@ -103,17 +104,7 @@ def test_every_control_and_scene_node_exists(name: str) -> None:
         assert set(g.gains) == {"g_b", "g_m", "G_p", "G_d", "k_p", "k_d"}
         assert all("(" in s.label for s in g.gains.values())  # units in every gain label
         assert g.speed.options == ("1/8×", "1/4×", "1/2×", "1×", "2×")
-        assert set(g.presets_trep.options) | set(g.presets_3r.options) == {
-            "fig3",
-            "fig4",
-            "fig10-on",
-            "fig10-off",
-            "fig11-slow",
-            "fig11-fast",
-            "fig11-joint2",
-            "fig12-on",
-            "fig12-off",
-        }
+        assert set(g.presets_trep.options) | set(g.presets_3r.options) == PAPER_PRESETS
         assert g.path_folder.visible == (name == "trep") and g.target_folder.visible == (name == "planar3r")
         for node in (FsmsScene.BASE, FsmsScene.FORCE, FsmsScene.TARGET, TARGET_HANDLE):
             assert app.server.scene.get_handle_by_name(node) is not None, node
@@ -125,7 +116,7 @@ def test_every_control_and_scene_node_exists(name: str) -> None:
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
-def test_kick_button_deflects_the_base(trep_app: RnsApp, client: WsClient) -> None:
+def test_kick_button_deflects_the_base(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     s.advance(0.2)
     assert abs(s.snapshot().q[0]) < 1e-9
@@ -158,7 +149,7 @@ def test_suppression_decays_faster_than_the_shadow_run(name: str) -> None:
 
 
 @pytest.mark.parametrize("client", ["planar_app"], indirect=True)
-def test_target_drag_moves_the_3r_end_effector_without_reaction(planar_app: RnsApp, client: WsClient) -> None:
+def test_target_drag_moves_the_3r_end_effector_without_reaction(planar_app: RnsApp, client: ProtocolClient) -> None:
     s, model = planar_app.session, planar_app.model
     start = model.ee_position(model.spec.default_configuration)
     goal = start + np.array([-0.4, -0.3, 0.0])
@@ -175,7 +166,7 @@ def test_target_drag_moves_the_3r_end_effector_without_reaction(planar_app: RnsA
 
 
 @pytest.mark.parametrize("client", ["planar_app"], indirect=True)
-def test_unreachable_3r_target_is_clamped_and_reported(planar_app: RnsApp, client: WsClient) -> None:
+def test_unreachable_3r_target_is_clamped_and_reported(planar_app: RnsApp, client: ProtocolClient) -> None:
     s = planar_app.session
     client.drag(TARGET_HANDLE, (4.0, 0.0, 0.0), "start")
     client.drag(TARGET_HANDLE, (4.0, 0.0, 0.0), "end")
@@ -189,7 +180,7 @@ def test_unreachable_3r_target_is_clamped_and_reported(planar_app: RnsApp, clien
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
-def test_scrubbing_trep_along_its_path_keeps_the_base_still(trep_app: RnsApp, client: WsClient) -> None:
+def test_scrubbing_trep_along_its_path_keeps_the_base_still(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     theta0 = s.snapshot().q[1:].copy()
     client.set_value(uuid(trep_app.gui.sigma), 40.0)
@@ -250,7 +241,7 @@ def test_model_switch_resets_cleanly(trep_app: RnsApp) -> None:
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
-def test_invalid_gain_input_is_refused_and_the_old_value_kept(trep_app: RnsApp, client: WsClient) -> None:
+def test_invalid_gain_input_is_refused_and_the_old_value_kept(trep_app: RnsApp, client: ProtocolClient) -> None:
     s, slider = trep_app.session, trep_app.gui.gains["g_b"]
     old = s.snapshot().settings.gains.g_b
     for bad in (float("nan"), -5.0, float("inf")):
@@ -337,7 +328,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
-def test_log_download_has_the_step_log_columns(trep_app: RnsApp, client: WsClient) -> None:
+def test_log_download_has_the_step_log_columns(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     s.advance(0.5)
     text = s.log_csv().decode()
@@ -349,7 +340,7 @@ def test_log_download_has_the_step_log_columns(trep_app: RnsApp, client: WsClien
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
-def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: WsClient) -> None:
+def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     ee = trep_app.model.ee_position(s.snapshot().q[1:])
     client.drag(TARGET_HANDLE, (ee[0] + 0.02, ee[1], ee[2]), "start")
@@ -357,7 +348,7 @@ def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: WsCli
     wait_for_clients(trep_app, 0, "the client to disconnect")
     s.advance(1.0)
     assert not s.snapshot().paused and s.snapshot().t > 0.9
-    other = WsClient(trep_app.port)
+    other = ProtocolClient(trep_app.port, decode=True)
     try:
         wait_for_clients(trep_app, 1, "a new client")
         other.click(uuid(trep_app.gui.kick))
@@ -387,7 +378,7 @@ def test_real_time_pacing_and_latency() -> None:
 
 def test_with_a_password_unknown_clients_only_watch() -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False, password="s3cret")
-    ws = WsClient(app.port)
+    ws = ProtocolClient(app.port, decode=True)
     try:
         wait_for_clients(app, 1, "a client")
         ws.click(uuid(app.gui.kick))

@@ -11,7 +11,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.session import Session
 from rns_viz.viz.app import start_app
 from tests.browser import wait_until
-from tests.ws_client import WsClient
+from tests.protocol_client import ProtocolClient
 
 
 def test_bounds_come_from_the_urdf(trep: FsmsModel) -> None:
@@ -51,7 +51,7 @@ def test_base_pushed_past_its_limit_pauses_and_reset_recovers() -> None:
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
 def test_an_unstable_gain_pauses_and_every_client_is_told(name: str) -> None:
     app = start_app(name, port=0, realtime=False, verbose=False)
-    clients = [WsClient(app.port) for _ in range(2)]
+    clients = [ProtocolClient(app.port, decode=True) for _ in range(2)]
     try:
         wait_until(lambda: len(app.server.get_clients()) == 2, 10.0, "two clients")
         s = app.session

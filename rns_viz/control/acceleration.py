@@ -14,40 +14,14 @@ import operator
 
 import numpy as np
 
-from rns_viz.control.common import (
-    ControlOutput,
-    Coupling,
-    CouplingEvaluator,
-    Gains,
-    range_acceleration,
-    realize_acceleration,
-)
-from rns_viz.control.null_input import DampNullMotion, NullInput, NullOutput
-from rns_viz.model import FsmsModel
+from rns_viz.control.common import ControlOutput, Coupling, range_acceleration, realize_acceleration
+from rns_viz.control.composite import CompositeLaw
+from rns_viz.control.null_input import DampNullMotion, NullOutput
 from rns_viz.rns import damping_squared
 
 
-class AccelerationLaw:
+class AccelerationLaw(CompositeLaw):
     """Eq. (15); ``suppress=False`` drops the G_b term (the reactionless part remains)."""
-
-    def __init__(
-        self,
-        model: FsmsModel,
-        gains: Gains,
-        null_input: NullInput | None = None,
-        suppress: bool = True,
-        suppress_after: float = float("-inf"),
-    ) -> None:
-        self.model = model
-        self.gains = gains
-        self.null_input = null_input or DampNullMotion(gains.g_m)
-        self.suppress = suppress
-        self.suppress_after = suppress_after  # s: suppression starts here (Fig. 3)
-        self.coupling = CouplingEvaluator(model)
-
-    def suppression_gain(self, t: float) -> float:
-        """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
-        return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
 
     def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, Coupling, NullOutput]:
         """theta'' of Eq. (15), with the coupling and null-space input it used.

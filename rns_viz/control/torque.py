@@ -13,33 +13,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from rns_viz.control.common import ControlOutput, CouplingEvaluator, Gains
-from rns_viz.control.null_input import DampNullMotion, NullInput
-from rns_viz.model import FsmsModel
+from rns_viz.control.common import ControlOutput
+from rns_viz.control.composite import CompositeLaw
 
 
-class TorqueLaw:
+class TorqueLaw(CompositeLaw):
     """Eq. (16); ``suppress=False`` drops the G_b term."""
-
-    def __init__(
-        self,
-        model: FsmsModel,
-        gains: Gains,
-        null_input: NullInput | None = None,
-        suppress: bool = True,
-        suppress_after: float = float("-inf"),
-    ) -> None:
-        self.model = model
-        self.gains = gains
-        self.null_input = null_input or DampNullMotion(gains.g_m)
-        self.suppress = suppress
-        self.suppress_after = suppress_after  # s: suppression starts here (Fig. 3)
-        self.coupling = CouplingEvaluator(model)
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
         cp = self.coupling(q, v)
         m = self.model.m
-        g_b = self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
+        g_b = self.suppression_gain(t)
         null = self.null_input(t, cp, q, v)
         c_b = cp.c[:m][self.model.selected]
         vib = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - c_b)

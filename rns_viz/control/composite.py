@@ -1,0 +1,34 @@
+"""What the composite laws (15) and (16) share: gains, a null-space input and the switch of the G_b term."""
+
+from __future__ import annotations
+
+from rns_viz.control.common import CouplingEvaluator, Gains
+from rns_viz.control.null_input import DampNullMotion, NullInput
+from rns_viz.model import FsmsModel
+
+
+class CompositeLaw:
+    """Base of :class:`~rns_viz.control.AccelerationLaw` (15) and :class:`~rns_viz.control.TorqueLaw` (16).
+
+    ``null_input`` defaults to u = -G_m theta' (Fig. 3); ``suppress=False`` drops the G_b term, and
+    ``suppress_after`` (s) switches it on at that time (Fig. 3).
+    """
+
+    def __init__(
+        self,
+        model: FsmsModel,
+        gains: Gains,
+        null_input: NullInput | None = None,
+        suppress: bool = True,
+        suppress_after: float = float("-inf"),
+    ) -> None:
+        self.model = model
+        self.gains = gains
+        self.null_input = null_input or DampNullMotion(gains.g_m)
+        self.suppress = suppress
+        self.suppress_after = suppress_after
+        self.coupling = CouplingEvaluator(model)
+
+    def suppression_gain(self, t: float) -> float:
+        """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
+        return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
