@@ -15,6 +15,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
+from rns_viz import _native as rns_native
 from rns_viz.model import FsmsModel
 from rns_viz.paths import default_seeds, path_family, potential
 
@@ -64,6 +65,10 @@ def main() -> None:
     model = FsmsModel.from_name("trep")
     seeds = default_seeds(model, args.count)
     ours = median_ms(lambda: path_family(model, args.count), args.repeats)
+    kernels = "native" if rns_native.core is not None else f"Python ({rns_native.why})"
+    saved, rns_native.core = rns_native.core, None  # the same tracer with pinocchio called from Python
+    python_kernels = median_ms(lambda: path_family(model, args.count), max(3, args.repeats // 3))
+    rns_native.core = saved
     base = median_ms(lambda: solve_ivp_family(model, seeds), max(3, args.repeats // 5))
     loose = median_ms(lambda: solve_ivp_family(model, seeds, method="RK45", rtol=1e-6), max(3, args.repeats // 3))
     paths = path_family(model, args.count)
@@ -76,7 +81,8 @@ def main() -> None:
     points = sum(len(p.s) for p in paths)
     print(f"TREP path family, {args.count} curves, {points} points, ends: {sorted({p.end for p in paths})}")
     print(f"{'method':<28}{'median ms':>10}{'w x_cm drift / range':>24}")
-    print(f"{'rns_viz path_family':<28}{ours:>10.1f}{drift:>24.1e}")
+    print(f"{'rns_viz path_family':<28}{ours:>10.1f}{drift:>24.1e}   (centre-of-mass kernels: {kernels})")
+    print(f"{'  same, Python kernels':<28}{python_kernels:>10.1f}")
     print(f"{'solve_ivp RK45 rtol 1e-6':<28}{loose:>10.1f}{loose_drift:>24.1e}")
     print(f"{'solve_ivp DOP853 rtol 1e-9':<28}{base:>10.1f}{base_drift:>24.1e}")
     print(f"speed-up: {loose / ours:.1f}x over RK45 1e-6, {base / ours:.1f}x over DOP853 1e-9")

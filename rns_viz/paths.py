@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from rns_viz import _native
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector
 
@@ -30,16 +31,22 @@ class ReactionlessPath:
     end: str  # why tracing stopped: "closed", "joint limit", "singularity" or "max length"
 
 
+_NO_COM = np.empty(0)  # "no centre of mass wanted" for the native kernel
+
+
 class CouplingField:
     """The coupling rows S H_bm, and their potential where one exists, at many configurations.
 
     For a translating base, row i of H_bm is M_total a_i . J_com (the base momentum along axis
     a_i) and M_total a_i . r_com its potential (Eq. 26, up to a constant): one
     jacobianCenterOfMass call gives both. Other bases read H_bm from crba and have no potential.
+    With the native extension built, the K configurations of a call go to pinocchio in one C++
+    call (``native=False``: one Python call each, the same numbers).
     """
 
-    def __init__(self, model: FsmsModel) -> None:
+    def __init__(self, model: FsmsModel, native: bool = True) -> None:
         self.model = model
+        self.native = _native.core if native else None
         self.q = np.zeros(model.nv)
         self.rows = model.selected
         self.m = model.m
@@ -61,6 +68,11 @@ class CouplingField:
             return H, None
         J = np.empty((K, 3, n))
         com = np.empty((K, 3))
+        if self.native is not None:
+            flat = np.ascontiguousarray(thetas, dtype=float).reshape(-1)
+            self.native.com_jacobians(pm, m, flat, J.reshape(-1), com.reshape(-1) if want_potential else _NO_COM)
+            H = np.einsum("ra,kan->krn", self.scaled_axes, J)
+            return H, (com @ self.scaled_axes.T if want_potential else None)
         jacobian_com = pin.jacobianCenterOfMass
         for k in range(K):
             q[m:] = thetas[k]
@@ -74,6 +86,9 @@ class CouplingField:
         """Potentials (K, r) alone, kg m: one centerOfMass call each (translating base only)."""
         pm, data, q, m = self.model.pin_model, self.model.data, self.q, self.m
         com = np.empty((len(thetas), 3))
+        if self.native is not None:
+            self.native.centers_of_mass(pm, m, np.ascontiguousarray(thetas, dtype=float).reshape(-1), com.reshape(-1))
+            return com @ self.scaled_axes.T
         for k in range(len(thetas)):
             q[m:] = thetas[k]
             com[k] = pin.centerOfMass(pm, data, q, False)

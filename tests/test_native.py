@@ -4,7 +4,8 @@ Trajectories with a kick, suppression switching on and gains changed mid-run agr
 do the paper's presets run both ways; the laws alone agree at random states, at the TREP
 singularity, for a 2-DOF base with one or both rows selected (the SVD branch) and with gravity (the
 Coriolis branch of H_bm' theta'). CI sets RNS_VIZ_REQUIRE_NATIVE=1: a missing extension fails there.
-Eq. (24) tracking is compared on the 3R (a 2-D RNS) and on the 2-DOF base.
+Eq. (24) tracking is compared on the 3R (a 2-D RNS) and on the 2-DOF base; the path tracer's
+centre-of-mass kernels against pinocchio's Python calls.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from rns_viz.control import (
 )
 from rns_viz.live.laws import PlanarTrackEndEffector
 from rns_viz.model import FsmsModel
+from rns_viz.paths import CouplingField, path_family
 from rns_viz.scenarios import SCENARIOS, run_scenario
 from rns_viz.sim import ForcePulse, SimulationDiverged, Simulator, native
 
@@ -243,3 +245,28 @@ def test_divergence_keeps_the_last_finite_state() -> None:
     with pytest.raises(SimulationDiverged, match="non-finite"):
         sim.step()
     assert np.array_equal(sim._x, x_before, equal_nan=True) and sim.t == 0.0
+
+
+@pytest.mark.parametrize("name", ["trep", "planar3r"])
+def test_centre_of_mass_kernels_agree(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The path tracer's batch kernels give pinocchio's numbers: the same family, the same set."""
+    import rns_viz._native
+
+    model = FsmsModel.from_name(name)
+    thetas = RNG.uniform(-math.pi, math.pi, (25, model.n))
+    fast = CouplingField(model)
+    assert fast.native is not None
+    monkeypatch.setattr(rns_viz._native, "core", None)
+    slow = CouplingField(model)
+    assert slow.native is None
+    (H_fast, pot_fast), (H_slow, pot_slow) = fast.rows_at(thetas, True), slow.rows_at(thetas, True)
+    assert np.allclose(H_fast, H_slow, rtol=0, atol=1e-14) and np.allclose(pot_fast, pot_slow, rtol=0, atol=1e-14)
+    assert np.allclose(fast.rows_at(thetas)[0], H_slow, rtol=0, atol=1e-14)
+    assert np.allclose(fast.potentials(thetas), slow.potentials(thetas), rtol=0, atol=1e-14)
+    if name == "trep":
+        python_family = path_family(model, 12)
+        monkeypatch.undo()
+        native_family = path_family(model, 12)
+        assert [p.end for p in native_family] == [p.end for p in python_family]
+        for a, b in zip(native_family, python_family, strict=True):
+            assert a.theta.shape == b.theta.shape and np.allclose(a.theta, b.theta, rtol=0, atol=1e-12)

@@ -14,9 +14,14 @@
 // cb_is_hbm_dot, ee_frame_id, base_joint_id, task_rows). Each *_step writes the next state, the torque and the coupling momentum into the
 // given float64 arrays and returns sigma_min(S H_bm) (FloatingPointError when they are not finite);
 // each *_control computes the law alone.
+//
+// Also batch kernels for the reactionless-path tracer (rns_viz.paths.CouplingField):
+// com_jacobians(pin_model, m, thetas, J, com) and centers_of_mass(pin_model, m, thetas, com) evaluate
+// pinocchio's centre-of-mass Jacobian / position at K arm configurations (x_b = 0) in one call.
 
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/center-of-mass.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
@@ -342,6 +347,39 @@ ClosedLoop* make_closed_loop(const Model& model, const bp::object& rows, const M
                         base_joint, int_list(task_rows));
 }
 
+// K configurations theta (K*n, row after row) with x_b = 0: writes J_com's arm columns (K*3*n,
+// each 3 x n row-major) and, if com has 3*K entries, the centre of mass (pinocchio, world frame).
+void com_jacobians(const Model& model, int m, const ConstRef& thetas, Ref J, Ref com) {
+  const Index n = model.nv - m;
+  if (m < 1 || n < 1 || model.nq != model.nv || thetas.size() % n != 0)
+    throw std::invalid_argument("thetas must hold K rows of the arm's n joint angles");
+  const Index K = thetas.size() / n;
+  const bool want_com = com.size() == 3 * K;
+  if (J.size() != 3 * n * K || !(want_com || com.size() == 0))
+    throw std::invalid_argument("J has K*3*n entries and com 3*K (or none)");
+  Data data(model);
+  VectorXd q = VectorXd::Zero(model.nq);
+  for (Index k = 0; k < K; ++k) {
+    q.tail(n) = thetas.segment(k * n, n);
+    const auto& Jc = pinocchio::jacobianCenterOfMass(model, data, q, false);
+    for (Index r = 0; r < 3; ++r) J.segment(k * 3 * n + r * n, n) = Jc.row(r).tail(n).transpose();
+    if (want_com) com.segment(3 * k, 3) = data.com[0];
+  }
+}
+
+// The centre of mass alone (K*3 entries) at K arm configurations, x_b = 0.
+void centers_of_mass(const Model& model, int m, const ConstRef& thetas, Ref com) {
+  const Index n = model.nv - m;
+  if (m < 1 || n < 1 || model.nq != model.nv || thetas.size() % n != 0 || com.size() != 3 * (thetas.size() / n))
+    throw std::invalid_argument("thetas holds K rows of n angles, com 3*K entries");
+  Data data(model);
+  VectorXd q = VectorXd::Zero(model.nq);
+  for (Index k = 0; k < thetas.size() / n; ++k) {
+    q.tail(n) = thetas.segment(k * n, n);
+    com.segment(3 * k, 3) = pinocchio::centerOfMass(model, data, q, false);
+  }
+}
+
 void translate(const std::invalid_argument& e) { PyErr_SetString(PyExc_ValueError, e.what()); }
 void translate_diverged(const std::domain_error& e) { PyErr_SetString(PyExc_FloatingPointError, e.what()); }
 
@@ -362,4 +400,6 @@ BOOST_PYTHON_MODULE(_closed_loop) {
       .def("task_step", &ClosedLoop::task_step)
       .def("velocity_control", &ClosedLoop::velocity_control)
       .def("velocity_step", &ClosedLoop::velocity_step);
+  bp::def("com_jacobians", &com_jacobians);
+  bp::def("centers_of_mass", &centers_of_mass);
 }

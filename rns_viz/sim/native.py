@@ -18,18 +18,12 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import pinocchio  # noqa: F401  (loads the libraries the extension links, and registers pin.Model)
 
+from rns_viz import _native
 from rns_viz.control import AccelerationLaw, ControlOutput, DampNullMotion, VelocityLaw
 from rns_viz.model import FsmsModel
 
-try:
-    from rns_viz import _closed_loop
-except ImportError as exc:  # not built (no compiler at install time) or built against other libraries
-    _closed_loop = None
-    _WHY: str | None = f"rns_viz._closed_loop did not import ({exc})"
-else:
-    _WHY = None
+_closed_loop, _WHY = _native.core, _native.why
 
 
 Ref = np.ndarray | None  # theta_ref, or ee_ref (the target x_d) for Eq. (24)
