@@ -25,20 +25,22 @@ from tests.protocol_client import ProtocolClient
 from tests.test_scenarios import PAPER_PRESETS
 
 
-@pytest.fixture
-def trep_app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, realtime=False, verbose=False)
+def stepped_app(model: str) -> Iterator[RnsApp]:
+    """An app the test steps itself (no real-time loop), background jobs done; stopped afterwards."""
+    app = start_app(model, port=0, realtime=False, verbose=False)
     assert app.session.wait_background()
     yield app
     app.stop()
+
+
+@pytest.fixture
+def trep_app() -> Iterator[RnsApp]:
+    yield from stepped_app("trep")
 
 
 @pytest.fixture
 def planar_app() -> Iterator[RnsApp]:
-    app = start_app("planar3r", port=0, realtime=False, verbose=False)
-    assert app.session.wait_background()
-    yield app
-    app.stop()
+    yield from stepped_app("planar3r")
 
 
 @pytest.fixture

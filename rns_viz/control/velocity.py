@@ -40,11 +40,15 @@ class VelocityLaw:
         self.feedforward = feedforward
         self.coupling = CouplingEvaluator(model)
 
+    def suppression_gain(self, t: float) -> float:
+        """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
+        return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
+
     def command(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, Coupling]:
         """theta'_cmd of Eq. (30), theta_ref and the coupling it used."""
         cp = self.coupling(q, v)
         theta_r, thetadot_r, _ = self.reference(t)
-        g_b = self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
+        g_b = self.suppression_gain(t)
         cmd = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.x_b)) + self.gains.g_m * (theta_r - cp.theta)
         if self.feedforward:
             cmd = cmd + thetadot_r

@@ -137,8 +137,7 @@ class NativeStep:
         law, core = self.law, self._core
         theta_r, thetadot_r, _ = law.reference(t)  # type: ignore[union-attr]
         theta_r, thetadot_r = _vector(theta_r), _vector(thetadot_r)
-        g_b = law.gains.g_b if law.suppress and t >= law.suppress_after else 0.0  # type: ignore[union-attr]
-        args = (g_b, law.gains.g_m, law.gains.servo_bandwidth, law.feedforward, theta_r, thetadot_r)  # type: ignore[union-attr]
+        args = (law.suppression_gain(t), law.gains.g_m, law.gains.servo_bandwidth, law.feedforward, theta_r, thetadot_r)  # type: ignore[union-attr]
         return (core.velocity_control if control else core.velocity_step), args, theta_r
 
 
