@@ -1,7 +1,7 @@
 """The paper's control laws, one module each, one call signature: law(t, q, v) -> ControlOutput."""
 
 from rns_viz.control.acceleration import AccelerationLaw
-from rns_viz.control.common import ControlLaw, ControlOutput, Gains, InvalidGain
+from rns_viz.control.common import ControlLaw, ControlOutput, Gains, InvalidGain, LawKind
 from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.null_input import (
     DampNullMotion,
@@ -10,7 +10,14 @@ from rns_viz.control.null_input import (
     TrackEndEffector,
     TrackJointReference,
 )
-from rns_viz.control.reference import FixedReference, JointQuintic, PathReference
+from rns_viz.control.reference import (
+    FixedReference,
+    JointQuintic,
+    JointSample,
+    PathReference,
+    ReferenceSample,
+    TaskSample,
+)
 from rns_viz.control.torque import TorqueLaw
 from rns_viz.control.velocity import VelocityLaw
 
@@ -23,11 +30,15 @@ __all__ = [
     "Gains",
     "InvalidGain",
     "JointQuintic",
+    "JointSample",
     "JointServo",
+    "LawKind",
     "MovableTarget",
     "PathReference",
+    "ReferenceSample",
     "Switched",
     "TaskQuintic",
+    "TaskSample",
     "TorqueLaw",
     "TrackEndEffector",
     "TrackJointReference",

@@ -23,6 +23,8 @@ from rns_viz.rns import damping_squared
 class AccelerationLaw(CompositeLaw):
     """Eq. (15); ``suppress=False`` drops the G_b term (the reactionless part remains)."""
 
+    kind = "acceleration"
+
     def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, Coupling, NullOutput]:
         """theta'' of Eq. (15), with the coupling and null-space input it used.
 

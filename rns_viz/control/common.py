@@ -8,12 +8,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from typing import Protocol
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import numpy as np
 
 from rns_viz.model import FsmsModel
+
+if TYPE_CHECKING:
+    from rns_viz.control.reference import ReferenceSample
 from rns_viz.rns import damped_pinv, damped_row_inverse
+
+LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
 
 class InvalidGain(ValueError):
@@ -59,9 +64,29 @@ class ControlOutput:
 
 
 class ControlLaw(Protocol):
-    """The one signature of every law."""
+    """The one signature of every law, and what a live loop may change between two steps."""
+
+    gains: Gains
+
+    @property
+    def kind(self) -> LawKind: ...
+
+    @property
+    def suppress(self) -> bool: ...
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput: ...
+
+    def retune(self, gains: Gains) -> None:
+        """New gains (and the null-space input's), from the next step on."""
+        ...
+
+    def set_suppression(self, on: bool) -> None:
+        """Switch vibration suppression (the g_b term) on or off."""
+        ...
+
+    def follow(self, sample: ReferenceSample) -> None:
+        """Track this reference sample from the next step on (TypeError if the law tracks no such thing)."""
+        ...
 
 
 class Coupling:

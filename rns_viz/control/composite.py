@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
-from rns_viz.control.common import CouplingEvaluator, Gains
+from typing import ClassVar
+
+from rns_viz.control.common import CouplingEvaluator, Gains, LawKind
 from rns_viz.control.null_input import DampNullMotion, NullInput
+from rns_viz.control.reference import ReferenceSample
 from rns_viz.model import FsmsModel
 
 
@@ -13,6 +16,8 @@ class CompositeLaw:
     ``null_input`` defaults to u = -G_m theta' (Fig. 3); ``suppress=False`` drops the G_b term, and
     ``suppress_after`` (s) switches it on at that time (Fig. 3).
     """
+
+    kind: ClassVar[LawKind]
 
     def __init__(
         self,
@@ -32,3 +37,16 @@ class CompositeLaw:
     def suppression_gain(self, t: float) -> float:
         """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
         return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
+
+    def retune(self, gains: Gains) -> None:
+        """New gains for the law and its null-space input, from the next step on."""
+        self.gains = gains
+        self.null_input.retune(gains)
+
+    def set_suppression(self, on: bool) -> None:
+        """Switch the G_b term on or off."""
+        self.suppress = on
+
+    def follow(self, sample: ReferenceSample) -> None:
+        """The reference the null-space input tracks from the next step on."""
+        self.null_input.follow(sample)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rns_viz.control.common import ControlLaw, ControlOutput, CouplingEvaluator, Gains, realize_acceleration
-from rns_viz.control.reference import JointReference
+from rns_viz.control.common import ControlLaw, ControlOutput, CouplingEvaluator, Gains, LawKind, realize_acceleration
+from rns_viz.control.reference import JointReference, JointSample, ReferenceSample
 from rns_viz.model import FsmsModel
 
 
@@ -15,11 +15,25 @@ class JointServo:
     With a fixed reference this is "joints held": the arm does nothing about the base.
     """
 
+    kind = "servo"
+    suppress = False  # nothing to switch: the servo ignores the base
+
     def __init__(self, model: FsmsModel, gains: Gains, reference: JointReference) -> None:
         self.model = model
         self.gains = gains
         self.reference = reference
         self.coupling = CouplingEvaluator(model)
+
+    def retune(self, gains: Gains) -> None:
+        self.gains = gains
+
+    def set_suppression(self, on: bool) -> None:
+        """No g_b term to switch: the servo stays a comparison without suppression."""
+
+    def follow(self, sample: ReferenceSample) -> None:
+        if not isinstance(sample, JointSample):
+            raise TypeError(f"the joint servo follows a joint reference, not a {type(sample).__name__}")
+        self.reference = sample
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
         cp = self.coupling(q, v)
@@ -39,6 +53,30 @@ class Switched:
 
     def __init__(self, before: ControlLaw, after: ControlLaw, at: float) -> None:
         self.before, self.after, self.at = before, after, at
+
+    # A switch counts as the law it switches to.
+    @property
+    def kind(self) -> LawKind:
+        return self.after.kind
+
+    @property
+    def gains(self) -> Gains:
+        return self.after.gains
+
+    @property
+    def suppress(self) -> bool:
+        return self.after.suppress
+
+    def retune(self, gains: Gains) -> None:
+        self.before.retune(gains)
+        self.after.retune(gains)
+
+    def set_suppression(self, on: bool) -> None:
+        self.after.set_suppression(on)
+
+    def follow(self, sample: ReferenceSample) -> None:
+        self.before.follow(sample)
+        self.after.follow(sample)
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
         return (self.after if t >= self.at else self.before)(t, q, v)

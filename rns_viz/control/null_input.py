@@ -12,8 +12,8 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
-from rns_viz.control.common import Coupling
-from rns_viz.control.reference import JointReference
+from rns_viz.control.common import Coupling, Gains
+from rns_viz.control.reference import JointReference, JointSample, ReferenceSample, TaskSample
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import QuinticSegment
 from rns_viz.rns import damped_pinv
@@ -30,6 +30,18 @@ class NullOutput:
 class NullInput(Protocol):
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput: ...
 
+    def retune(self, gains: Gains) -> None:
+        """Take this input's gains from ``gains``."""
+        ...
+
+    def follow(self, sample: ReferenceSample) -> None:
+        """Track ``sample`` from the next evaluation on (TypeError if this input tracks no such thing)."""
+        ...
+
+
+def _refuse(owner: object, sample: object) -> TypeError:
+    return TypeError(f"{type(owner).__name__} cannot follow a {type(sample).__name__}")
+
 
 @dataclass
 class DampNullMotion:
@@ -41,6 +53,12 @@ class DampNullMotion:
 
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
         return NullOutput(-self.g_m * (cp.P @ cp.thetadot))
+
+    def retune(self, gains: Gains) -> None:
+        self.g_m = gains.g_m
+
+    def follow(self, sample: ReferenceSample) -> None:
+        raise _refuse(self, sample)
 
 
 @dataclass
@@ -57,6 +75,14 @@ class TrackJointReference:
         theta_r, thetadot_r, thetaddot_r = self.reference(t)
         u = thetaddot_r + self.k_d * (thetadot_r - cp.thetadot) + self.k_p * (theta_r - cp.theta)
         return NullOutput(cp.P @ u, theta_ref=theta_r)
+
+    def retune(self, gains: Gains) -> None:
+        self.k_p, self.k_d = gains.k_p, gains.k_d
+
+    def follow(self, sample: ReferenceSample) -> None:
+        if not isinstance(sample, JointSample):
+            raise _refuse(self, sample)
+        self.reference = sample
 
 
 class TaskReference(Protocol):
@@ -91,6 +117,14 @@ class TrackEndEffector:
         inv = damped_pinv(J_bar, self.threshold, self.threshold)
         rhs = xddot_d + self.G_d * edot + self.G_p * e - Jdot_thetadot + J @ (cp.H_bm_pinv @ cp.hbm_dot_thetadot)
         return NullOutput(inv.inverse @ rhs, sigma_jbar=inv.sigma_min, ee_ref=x_d)
+
+    def retune(self, gains: Gains) -> None:
+        self.G_p, self.G_d = gains.G_p, gains.G_d
+
+    def follow(self, sample: ReferenceSample) -> None:
+        if not isinstance(sample, TaskSample):
+            raise _refuse(self, sample)
+        self.target = sample
 
 
 TaskQuintic = QuinticSegment  # straight end-effector path, quintic in time (Fig. 4)

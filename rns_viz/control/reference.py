@@ -34,6 +34,44 @@ class FixedReference:
 JointQuintic = QuinticSegment  # point-to-point joint motion (Fig. 11(b))
 
 
+@dataclass(frozen=True)
+class JointSample:
+    """theta_ref, theta_ref', theta_ref'' at one instant (rad, rad/s, rad/s^2): what a live loop hands a
+    law with :meth:`follow` at each step. Immutable, so no one changes it behind the law's back."""
+
+    theta: np.ndarray
+    thetadot: np.ndarray
+    thetaddot: np.ndarray
+
+    @classmethod
+    def held(cls, theta: np.ndarray) -> JointSample:
+        theta = np.array(theta, dtype=float)
+        return cls(theta, np.zeros_like(theta), np.zeros_like(theta))
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.theta, self.thetadot, self.thetaddot
+
+
+@dataclass(frozen=True)
+class TaskSample:
+    """x_d, x_d', x_d'' at one instant, base frame, task rows (m, m/s, m/s^2); see :class:`JointSample`."""
+
+    x: np.ndarray
+    xdot: np.ndarray
+    xddot: np.ndarray
+
+    @classmethod
+    def held(cls, x: np.ndarray) -> TaskSample:
+        x = np.array(x, dtype=float)
+        return cls(x, np.zeros_like(x), np.zeros_like(x))
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.x, self.xdot, self.xddot
+
+
+ReferenceSample = JointSample | TaskSample
+
+
 class PathReference:
     """theta_ref' = n(theta_ref) u-bar(t): the reactionless reference path of Eq. (30).
 

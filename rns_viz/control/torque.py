@@ -20,6 +20,8 @@ from rns_viz.control.composite import CompositeLaw
 class TorqueLaw(CompositeLaw):
     """Eq. (16); ``suppress=False`` drops the G_b term."""
 
+    kind = "torque"
+
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
         cp = self.coupling(q, v)
         m = self.model.m

@@ -16,12 +16,14 @@ from __future__ import annotations
 import numpy as np
 
 from rns_viz.control.common import ControlOutput, Coupling, CouplingEvaluator, Gains, realize_acceleration
-from rns_viz.control.reference import JointReference
+from rns_viz.control.reference import JointReference, JointSample, ReferenceSample
 from rns_viz.model import FsmsModel
 
 
 class VelocityLaw:
     """Eq. (30); ``suppress=False`` sets the g_b term to zero: the joints just hold/track theta_ref."""
+
+    kind = "velocity"
 
     def __init__(
         self,
@@ -43,6 +45,17 @@ class VelocityLaw:
     def suppression_gain(self, t: float) -> float:
         """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
         return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
+
+    def retune(self, gains: Gains) -> None:
+        self.gains = gains
+
+    def set_suppression(self, on: bool) -> None:
+        self.suppress = on
+
+    def follow(self, sample: ReferenceSample) -> None:
+        if not isinstance(sample, JointSample):
+            raise TypeError(f"the velocity law (30) follows a joint reference, not a {type(sample).__name__}")
+        self.reference = sample
 
     def command(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, Coupling]:
         """theta'_cmd of Eq. (30), theta_ref and the coupling it used."""
