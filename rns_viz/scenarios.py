@@ -24,18 +24,16 @@ from rns_viz.control import (
 )
 from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.reference import path_integral_to
+from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import CyclicUbar, QuinticUbar
 from rns_viz.sim import ForcePulse, Simulator
 
-# "An arbitrary external force" (Sec. VII-D): a half-sine push on the beam tip along x.
-# 0.8 N for 0.1 s is an impulse of 0.051 N s, about 5 mm of deflection for TREP.
-TREP_KICK = dict(duration=0.1, peak=(0.8,))
-# The 3R base "excited due to some external force at t = 1 s" (Sec. VI): 5 N for 0.2 s on the
-# 31 kg base (impulse 0.64 N s, about 1.1 cm of deflection). Law (15) shifts w x_cm by
-# H_b g_b x_b / G_m to absorb it (DESIGN.md section 4); much larger kicks would need more than the
-# arm's reach and drive it into H_bm = 0.
-PLANAR3R_KICK = dict(start=1.0, duration=0.2, peak=(5.0,))
+# "An arbitrary external force" (Sec. VII-D): the kicks of rns_viz.defaults (why these sizes: there).
+_TREP, _PLANAR3R = defaults_for("trep"), defaults_for("planar3r")
+TREP_KICK = dict(duration=_TREP.kick_duration_s, peak=(_TREP.kick_peak_N,))
+# The 3R base "excited due to some external force at t = 1 s" (Sec. VI).
+PLANAR3R_KICK = dict(start=1.0, duration=_PLANAR3R.kick_duration_s, peak=(_PLANAR3R.kick_peak_N,))
 # Fig. 11: the reactionless path from theta = (90, 0) deg until joint 1 is back at 90 deg, which
 # happens at theta_2 = 180 deg (link 2 folded back). The "link 2 only" comparison is the
 # joint-space quintic between the same end points over the fast run's duration (the same

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from rns_viz.control import InvalidGain
-from rns_viz.session import Session
+from rns_viz.live.session import Session
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, serve, start_app
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import wait_for_clients, wait_until
@@ -62,7 +62,7 @@ def queued(app: RnsApp, kind: str, count: int = 1) -> None:
 
 
 def peak_xb(session: Session, seconds: float) -> float:
-    return float(np.abs(session.sim.log.column("xb_1", last=round(seconds / session.dt))).max())
+    return float(np.abs(session.state.runs.sim.log.column("xb_1", last=round(seconds / session.dt))).max())
 
 
 def envelope(session: Session, key: str, seconds: float) -> float:
@@ -123,7 +123,7 @@ def test_kick_button_deflects_the_base(trep_app: RnsApp, client: ProtocolClient)
     s.advance(0.2)
     assert abs(s.snapshot().q[0]) < 1e-9
     client.click(uuid(trep_app.gui.kick))
-    queued(trep_app, "kick")
+    queued(trep_app, "Kick")
     s.advance(0.15)
     assert abs(s.snapshot().q[0]) > 1e-3  # 0.8 N for 0.1 s: millimetres
     wait_until(lambda: trep_app.scene_updates > 0, 5.0, "a scene update")
@@ -136,14 +136,14 @@ def test_suppression_decays_faster_than_the_shadow_run(name: str) -> None:
         s = app.session
         assert app.gui.suppression.value and s.snapshot().settings.shadow
         app.gui.kick.value = True  # a click from the server side runs the same callback
-        queued(app, "kick")
+        queued(app, "Kick")
         s.advance(4.0)
         on, off = envelope(s, "xb", 1.0), envelope(s, "xb_shadow", 1.0)
         first = float(np.abs(s.plot_arrays()["xb_shadow"]).max())
         assert off > 0.5 * first  # the shadow (suppression off) still rings
         assert on < 0.3 * off, (on, off)
         app.gui.suppression.value = False  # the roles swap: the operated run now rings
-        queued(app, "suppress")
+        queued(app, "SetSuppression")
         s.advance(0.01)
         assert not s.snapshot().settings.suppress
     finally:
@@ -158,7 +158,7 @@ def test_target_drag_moves_the_3r_end_effector_without_reaction(planar_app: RnsA
     for k, phase in enumerate(("start", "update", "update", "end")):
         point = start + (k + 1) / 4 * (goal - start)
         client.drag(TARGET_HANDLE, (point[0], point[1], point[2]), phase)
-    wait_until(lambda: s.pending_commands().count("target") >= 5, 10.0, "the drag's target commands")
+    wait_until(lambda: s.pending_commands().count("DragTarget") >= 5, 10.0, "the drag's target commands")
     s.advance(4.0)
     snap = s.snapshot()
     ee = model.ee_position(snap.q[model.m :])
@@ -172,7 +172,7 @@ def test_unreachable_3r_target_is_clamped_and_reported(planar_app: RnsApp, clien
     s = planar_app.session
     client.drag(TARGET_HANDLE, (4.0, 0.0, 0.0), "start")
     client.drag(TARGET_HANDLE, (4.0, 0.0, 0.0), "end")
-    wait_until(lambda: s.pending_commands().count("target") >= 3, 10.0, "the target commands")
+    wait_until(lambda: s.pending_commands().count("DragTarget") >= 3, 10.0, "the target commands")
     s.advance(0.05)
     target = s.snapshot().target
     assert target is not None and target[0] < 2.5  # the 3R reaches 3 m, but not without reaction
@@ -186,18 +186,18 @@ def test_scrubbing_trep_along_its_path_keeps_the_base_still(trep_app: RnsApp, cl
     s = trep_app.session
     theta0 = s.snapshot().q[1:].copy()
     client.set_value(uuid(trep_app.gui.sigma), 40.0)
-    queued(trep_app, "scrub")
+    queued(trep_app, "Scrub")
     s.advance(4.0)
     snap = s.snapshot()
     assert np.linalg.norm(snap.q[1:] - theta0) > 0.5  # the arm moved a long way
     assert abs(snap.sigma - 40.0) < 0.5
     assert peak_xb(s, 4.0) <= 1e-4
     # A drag: the end effector goes to the point of the current path nearest the target.
-    table = s.operator.table
+    table = s.state.operator.table
     far = table.ee[len(table.ee) // 3] + np.array([0.01, 0.0, 0.0])
     client.drag(TARGET_HANDLE, tuple(far), "start")
     client.drag(TARGET_HANDLE, tuple(far), "end")
-    wait_until(lambda: s.pending_commands().count("target") >= 3, 10.0, "the target commands")
+    wait_until(lambda: s.pending_commands().count("DragTarget") >= 3, 10.0, "the target commands")
     s.advance(5.0)
     ee = trep_app.model.ee_position(s.snapshot().q[1:])
     assert np.linalg.norm(ee[:2] - s.snapshot().target[:2]) < 2e-3
@@ -208,11 +208,11 @@ def test_scrubbing_trep_along_its_path_keeps_the_base_still(trep_app: RnsApp, cl
 def test_point_to_point_comparison_shakes_the_base_and_the_path_does_not(trep_app: RnsApp) -> None:
     s = trep_app.session
     trep_app.gui.play_fast.value = True
-    queued(trep_app, "play")
+    queued(trep_app, "Play")
     s.advance(3.0)
     reactionless = peak_xb(s, 3.0)
     trep_app.gui.point_to_point.value = True
-    queued(trep_app, "p2p")
+    queued(trep_app, "PointToPoint")
     s.advance(3.0)
     joint_space = peak_xb(s, 3.0)
     assert reactionless < 1e-4 < joint_space and joint_space > 20 * reactionless
@@ -221,15 +221,15 @@ def test_point_to_point_comparison_shakes_the_base_and_the_path_does_not(trep_ap
 def test_model_switch_resets_cleanly(trep_app: RnsApp) -> None:
     s = trep_app.session
     trep_app.gui.kick.value = True
-    queued(trep_app, "kick")
+    queued(trep_app, "Kick")
     s.advance(1.0)
     trep_app.gui.model.value = "planar 3R on a spring"
-    queued(trep_app, "model")
+    queued(trep_app, "SwitchModel")
     s.advance(0.1)
     snap = s.snapshot()
     assert snap.settings.model == "planar3r" and snap.settings.preset is None
     assert snap.t == pytest.approx(0.1) and abs(snap.q[0]) < 1e-9
-    assert np.allclose(snap.q[1:], s.aux.spec.default_configuration)
+    assert np.allclose(snap.q[1:], s.state.model.spec.default_configuration)
     wait_until(lambda: trep_app.gui.target_folder.visible, 10.0, "the panel and scene to switch model")
     scene = trep_app.server.scene
     wait_until(lambda: scene.get_handle_by_name("/spring/coil") is not None, 10.0, "the spring")
@@ -237,7 +237,7 @@ def test_model_switch_resets_cleanly(trep_app: RnsApp) -> None:
     assert trep_app.gui.target_folder.visible and not trep_app.gui.path_folder.visible
     assert len(s.plot_arrays()["t"]) == 5  # the plots restarted with the new run (50 Hz samples)
     trep_app.gui.model.value = "TREP (2R on a flexible beam)"
-    queued(trep_app, "model")
+    queued(trep_app, "SwitchModel")
     s.advance(0.1)
     assert s.snapshot().settings.model == "trep" and s.snapshot().q.shape == (3,)
 
@@ -255,10 +255,10 @@ def test_invalid_gain_input_is_refused_and_the_old_value_kept(trep_app: RnsApp, 
     with pytest.raises(InvalidGain):
         s.set_gains(g_m=-1.0)
     client.set_value(uuid(slider), 12.0)  # a good value is applied
-    queued(trep_app, "gains")
+    queued(trep_app, "SetGains")
     s.advance(0.01)
     assert s.snapshot().settings.gains.g_b == 12.0
-    assert s.sim.law.gains.g_b == 12.0 and s.shadow.law.gains.g_b == 12.0
+    assert s.state.runs.sim.law.gains.g_b == 12.0 and s.state.runs.shadow.law.gains.g_b == 12.0
 
 
 def test_divergence_pauses_keeps_the_last_finite_state_and_reset_recovers(trep_app: RnsApp) -> None:
@@ -284,19 +284,19 @@ def test_pause_single_step_resume_and_speed(trep_app: RnsApp) -> None:
     s = trep_app.session
     s.advance(0.1)
     trep_app.gui.pause.value = True
-    queued(trep_app, "pause")
+    queued(trep_app, "Pause")
     s.advance(0.5)
     t = s.snapshot().t
     assert s.snapshot().paused and t == pytest.approx(0.1)
     trep_app.gui.step.value = True
-    queued(trep_app, "step")
+    queued(trep_app, "SingleStep")
     s.advance(0.0)
     assert s.snapshot().t == pytest.approx(t + 0.001)
     s.resume()
     s.advance(0.2)
     assert s.snapshot().t == pytest.approx(t + 0.201)
     trep_app.gui.speed.value = "1/2×"
-    queued(trep_app, "speed")
+    queued(trep_app, "SetSpeed")
     s.advance(0.0)
     assert s.snapshot().settings.speed == 0.5
 
@@ -306,7 +306,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
     try:
         s = app.session
         app.gui.presets_trep.value = "fig10-on"
-        queued(app, "preset")
+        queued(app, "LoadPreset")
         s.advance(0.0)
         assert s.wait_background()
         snap = s.snapshot()
@@ -316,7 +316,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
         s.advance(1.0)  # the preset's kick comes at 0.5 s
         assert peak_xb(s, 1.0) > 1e-3
         app.gui.presets_3r.value = "fig3"  # a 3R preset switches the model
-        queued(app, "preset")
+        queued(app, "LoadPreset")
         s.advance(0.0)
         assert s.wait_background()
         assert s.snapshot().settings.model == "planar3r" and s.snapshot().settings.preset == "fig3"
@@ -335,7 +335,7 @@ def test_log_download_has_the_step_log_columns(trep_app: RnsApp, client: Protoco
     s.advance(0.5)
     text = s.log_csv().decode()
     header, *rows = text.strip().splitlines()
-    assert header.split(",") == s.sim.log.columns
+    assert header.split(",") == s.state.runs.sim.log.columns
     assert len(rows) == 500 and all(math.isfinite(float(x)) for x in rows[-1].split(",")[:5])
     client.click(uuid(trep_app.gui.download))
     wait_until(lambda: client.types["FileTransferStartDownload"] >= 1, 10.0, "the CSV download to start")
@@ -354,7 +354,7 @@ def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: Proto
     try:
         wait_for_clients(trep_app, 1, "a new client")
         other.click(uuid(trep_app.gui.kick))
-        queued(trep_app, "kick")
+        queued(trep_app, "Kick")
     finally:
         other.close()
 
@@ -387,7 +387,7 @@ def test_with_a_password_unknown_clients_only_watch() -> None:
         wait_until(lambda: ws.types["NotificationShowMessage"] >= 1, 10.0, "the 'View only' notice")
         assert app.session.pending_commands() == []
         app.gui.kick.value = True  # the server itself (and tests) may always operate
-        queued(app, "kick")
+        queued(app, "Kick")
     finally:
         ws.close()
         app.stop()

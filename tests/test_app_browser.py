@@ -68,7 +68,7 @@ def test_operate_the_app_in_chromium(app: RnsApp) -> None:
         click_track(page, app.gui.kick_peak.label, 0.8)
         wait_until(lambda: app.gui.kick_peak.value > before, 10.0, "the kick-peak slider to move")
         if name == "trep":  # the path slider moves the arm along its reactionless path
-            wait_until(lambda: s.operator is not None and s.operator.table is not None, 20.0, "the path")
+            wait_until(lambda: s.state.operator is not None and s.state.operator.table is not None, 20.0, "the path")
             # The render thread sets the slider's range from the path; click only once the page has it.
             wait_until(lambda: app.gui.sigma.max > 10.0, 20.0, "the path slider's range")
             time.sleep(1.0)

@@ -74,7 +74,7 @@ def send(client: ProtocolClient, handle: Any, value: Any) -> None:
 
 def assert_finite_everywhere(app: RnsApp) -> None:
     s = app.session
-    for run in (s.sim, s.shadow):
+    for run in (s.state.runs.sim, s.state.runs.shadow):
         assert np.all(np.isfinite(run.q)) and np.all(np.isfinite(run.v)), (run.q, run.v)
     snap = s.snapshot()
     assert np.all(np.isfinite(snap.q)) and math.isfinite(snap.t)
@@ -139,7 +139,7 @@ def test_hostile_values_to_every_control(
 def test_afterwards_the_app_is_alive(hostile_app: tuple[RnsApp, ProtocolClient, ProtocolClient]) -> None:
     app, _, _ = hostile_app
     s = app.session
-    assert app._thread.is_alive() and s.worker._thread.is_alive()
+    assert app._thread.is_alive() and s.state.background.worker._thread.is_alive()
     late = ProtocolClient(app.port)
     try:
         wait_for_clients(app, 3, "a new client to connect")

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from rns_viz.live.guard import MAX_JOINT_SPEED, Bounds
+from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
-from rns_viz.session import Session
 from rns_viz.viz.app import start_app
 from tests.browser import wait_until
 from tests.protocol_client import ProtocolClient
@@ -29,7 +29,7 @@ def test_base_pushed_past_its_limit_pauses_and_reset_recovers() -> None:
     s = Session("trep", realtime=False)
     try:
         s.advance(0.1)
-        s.sim.q[0] = 0.15  # as if a huge force had thrown the base beyond its 0.1 m limit
+        s.state.runs.sim.q[0] = 0.15  # as if a huge force had thrown the base beyond its 0.1 m limit
         s.advance(0.1)
         snap = s.snapshot()
         assert snap.paused and snap.diverged and "physical bounds" in snap.diverged
@@ -61,12 +61,12 @@ def test_an_unstable_gain_pauses_and_every_client_is_told(name: str) -> None:
         s.advance(2.0)
         snap = s.snapshot()
         assert snap.paused and snap.diverged
-        assert np.all(np.isfinite(snap.q)) and np.all(np.isfinite(s.sim.v))
+        assert np.all(np.isfinite(snap.q)) and np.all(np.isfinite(s.state.runs.sim.v))
         for c, n in zip(clients, before, strict=True):
             wait_until(lambda c=c, n=n: c.types["NotificationShowMessage"] > n, 10.0, "the divergence notice")
         wait_until(lambda: app.gui.pause.label == "Reset (diverged)", 10.0, "the button to offer a reset")
         app.gui.pause.value = True  # the offered reset
-        wait_until(lambda: "reset" in s.pending_commands(), 10.0, "the reset command")
+        wait_until(lambda: "Reset" in s.pending_commands(), 10.0, "the reset command")
         s.set_gains(g_m=20.0, g_b=20.0)
         s.advance(0.3)
         snap = s.snapshot()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import tracemalloc
 
-from rns_viz.session import Session
+from rns_viz.live.session import Session
 
 
 def test_memory_stays_bounded_over_a_long_run() -> None:
@@ -28,6 +28,6 @@ def test_memory_stays_bounded_over_a_long_run() -> None:
         grown = sum(d.size_diff for d in after.compare_to(before, "filename"))
         assert grown < 1_000_000, f"{grown} bytes more after 5 s more of simulation"
         assert len(s.latencies()) <= 2000 and len(s.plot_arrays()["t"]) == 500
-        assert len(s.kicks.pulses) <= 1  # ended pulses are dropped
+        assert len(s.state.runs.kicks.pulses) <= 1  # ended pulses are dropped
     finally:
         s.stop()

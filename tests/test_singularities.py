@@ -7,21 +7,21 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.session import Session
+from rns_viz.live.session import Session
 
 
 def put_arm_at(s: Session, theta: list[float]) -> None:
-    m = s.sim.model.m
-    s.sim.q[m:] = theta
-    s.shadow.q[m:] = theta
-    s._go_live()  # live laws from this configuration, as after leaving a preset
+    m = s.state.runs.sim.model.m
+    s.state.runs.sim.q[m:] = theta
+    s.state.runs.shadow.q[m:] = theta
+    s.state.hold_here()  # live laws from this configuration, as after leaving a preset
     assert s.wait_background()
 
 
 def assert_finite(s: Session) -> None:
     snap = s.snapshot()
     assert snap.diverged is None and not snap.paused
-    for run in (s.sim, s.shadow):
+    for run in (s.state.runs.sim, s.state.runs.shadow):
         assert np.all(np.isfinite(run.q)) and np.all(np.isfinite(run.v))
     assert snap.target is None or np.all(np.isfinite(snap.target))
     assert all(np.all(np.isfinite(a)) for a in s.plot_arrays().values())
@@ -34,7 +34,7 @@ def test_stretched_arm_is_flagged_and_the_run_carries_on(name: str) -> None:
     s = Session(name, realtime=False)
     try:
         assert s.wait_background()
-        put_arm_at(s, [0.0] * s.aux.n)
+        put_arm_at(s, [0.0] * s.state.model.n)
         s.advance(0.3)
         r = s.snapshot().readouts
         assert r.sigma_hbm < r.warn_hbm  # shown in the warning colour

@@ -1,173 +1,229 @@
-"""How the live session applies queued commands: one handler per command kind, run by the loop.
+"""The live session's inputs as typed commands: one small frozen record per kind of input.
 
-:class:`CommandHandlers` is a mixin of :class:`rns_viz.session.Session`; handlers run only on the
-simulation loop's thread, between two steps. A handler that raises ``ValueError`` (including
-:class:`~rns_viz.live.operator.InputRefused` and :class:`~rns_viz.control.InvalidGain`) leaves
-everything as it was and the requesting client is told why.
+Constructing a command is the one place its input is checked: ``__post_init__`` raises a
+``ValueError`` (:class:`~rns_viz.control.InvalidGain` for gains) with a message for the user, and
+nothing is queued. The loop applies a command with a ``match`` on its type
+(:meth:`rns_viz.live.state.LiveState.apply`), so "go to definition" leads from an input to its effect.
+Every command carries the client that sent it (for replies) and when it arrived (for latency).
 """
 
 from __future__ import annotations
 
-import traceback
-from dataclasses import replace
-from typing import TYPE_CHECKING
+import math
+import time
+from dataclasses import dataclass, field, fields
+from types import MappingProxyType
+from typing import Any
 
-from rns_viz.live.kicks import kick_pulse
-from rns_viz.live.laws import LawKind, checked_gains, default_gains, retune, set_suppression
-from rns_viz.live.operator import InputRefused, Operator
-from rns_viz.live.records import Command
+import numpy as np
+
+from rns_viz.control import Gains, InvalidGain, LawKind
+from rns_viz.live.pacing import SPEEDS
+from rns_viz.params import MODEL_NAMES
 from rns_viz.scenarios import SCENARIOS
-from rns_viz.sim import Simulator
 
-if TYPE_CHECKING:
-    from rns_viz.session import Session
-
-KICK_DURATION = {"trep": 0.1, "planar3r": 0.2}  # s, as the presets' kicks
-TIMED_INPUTS = frozenset(
-    {"kick", "suppress", "gains", "ubar_speed", "target_speed", "target", "scrub", "play", "cyclic", "p2p", "law"}
-)  # operator inputs whose arrival-to-first-step latency is measured
+LIVE_LAWS: tuple[LawKind, ...] = ("acceleration", "torque", "velocity")
+MAX_KICK_N = 1e4  # N: larger peaks are refused as input errors, not physics
+MAX_TARGET_M = 1e3  # m: a farther target is refused outright (it would mean nothing)
+MAX_UBAR_SPEED = 1e4  # 1/(kg m s)
+MAX_TARGET_SPEED = 100.0  # m/s
+GAIN_NAMES = frozenset(f.name for f in fields(Gains))
 
 
-class CommandHandlers:
-    def _apply_commands(self: Session) -> None:
-        while self._commands:
-            cmd = self._commands.popleft()
-            try:
-                getattr(self, f"_cmd_{cmd.kind}")(cmd)
-            except (InputRefused, ValueError) as exc:
-                self._notify("Input not applied", str(exc), cmd.client, "warning")
-                self.settings_version += 1  # the GUI shows the values actually in force
-            except Exception as exc:
-                traceback.print_exc()
-                self._notify("Input not applied", f"{type(exc).__name__}: {exc}", cmd.client, "error")
-                self.settings_version += 1
-            if cmd.kind in TIMED_INPUTS:
-                self._awaiting.append(cmd.received)
-        self._publish()
-
-    def _cmd_pause(self: Session, cmd: Command) -> None:
-        self.paused = True
-
-    def _cmd_resume(self: Session, cmd: Command) -> None:
-        if self.diverged:
-            raise InputRefused(f"the simulation stopped ({self.diverged}); press Reset to start again")
-        self.paused = False
-        self.diverged = None
-        self.pacer.reanchor(self.sim.t)
-
-    def _cmd_step(self: Session, cmd: Command) -> None:
-        self.paused = True
-        for _ in range(cmd.args[0]):
-            if self.diverged:
-                break
-            self._tick()
-
-    def _cmd_reset(self: Session, cmd: Command) -> None:
-        if self.settings.preset is not None:
-            self._cmd_preset(Command("preset", (self.settings.preset,), cmd.client, cmd.received))
-        else:
-            self._init_live(self.settings.model)
-
-    def _cmd_speed(self: Session, cmd: Command) -> None:
-        self.pacer.set_speed(cmd.args[0], self.sim.t)
-        self.settings = replace(self.settings, speed=cmd.args[0])
-
-    def _cmd_kick(self: Session, cmd: Command) -> None:
-        model = self.settings.model
-        duration = KICK_DURATION.get(model, 0.1)
-        pulse = kick_pulse(self.sim.t, cmd.args[0], duration, self.sim.model.m)
-        self.kicks.add(pulse)
-        self.kicks_shadow.add(pulse)
-
-    def _cmd_suppress(self: Session, cmd: Command) -> None:
-        on = cmd.args[0]
-        set_suppression(self.sim.law, on)
-        set_suppression(self.shadow.law, not on)
-        self.settings = replace(self.settings, suppress=on)
-
-    def _cmd_law(self: Session, cmd: Command) -> None:
-        kind: LawKind = cmd.args[0]
-        model = self.settings.model
-        self._gain_memory[(model, self.settings.law)] = self.settings.gains
-        gains = self._gain_memory.get((model, kind), default_gains(model, kind))
-        self.settings = replace(self.settings, law=kind, gains=gains)
-        if self.operator is None:
-            self._go_live()
-        else:
-            self._install_live_laws()
-        self.settings_version += 1
-
-    def _cmd_gains(self: Session, cmd: Command) -> None:
-        gains = checked_gains(self.settings.gains, cmd.args[0])
-        retune(self.sim.law, gains)
-        retune(self.shadow.law, gains)
-        self.settings = replace(self.settings, gains=gains)
-
-    def _cmd_ubar_speed(self: Session, cmd: Command) -> None:
-        self.settings = replace(self.settings, ubar_speed=cmd.args[0])
-        if self.operator is not None:
-            self.operator.set_speeds(self.settings.ubar_speed, self.settings.target_speed)
-
-    def _cmd_target_speed(self: Session, cmd: Command) -> None:
-        self.settings = replace(self.settings, target_speed=cmd.args[0])
-        if self.operator is not None:
-            self.operator.set_speeds(self.settings.ubar_speed, self.settings.target_speed)
-
-    def _cmd_shadow(self: Session, cmd: Command) -> None:
-        on = cmd.args[0]
-        if on and not self.settings.shadow:
-            self._resync_shadow(None)
-        self.settings = replace(self.settings, shadow=on)
-
-    def _live_operator(self: Session) -> Operator:
-        if self.operator is None:
-            self._go_live()
-        assert self.operator is not None
-        return self.operator
-
-    def _cmd_target(self: Session, cmd: Command) -> None:
-        xy, final = cmd.args
-        op = self._live_operator()
-        moved = op.drag(xy, final)
-        if final:
-            self.target_version += 1
-            if moved:
-                x, y = op.target[:2]  # type: ignore[index]
-                self._notify(
-                    "Target clamped",
-                    f"That target is outside the set reachable without reaction from this configuration; "
-                    f"the arm goes to the nearest reachable point ({x:.2f}, {y:.2f}) m instead.",
-                    cmd.client,
-                    "warning",
-                )
-
-    def _cmd_scrub(self: Session, cmd: Command) -> None:
-        self._live_operator().scrub(cmd.args[0])
-        self.target_version += 1
-
-    def _cmd_play(self: Session, cmd: Command) -> None:
-        self._live_operator().play(self.sim.t, cmd.args[0])
-        self.target_version += 1
-
-    def _cmd_cyclic(self: Session, cmd: Command) -> None:
-        self._live_operator().cyclic(self.sim.t, cmd.args[0], self.settings.ubar_speed)
-
-    def _cmd_p2p(self: Session, cmd: Command) -> None:
-        self._live_operator().point_to_point(self.sim.t)
-        self.target_version += 1
-
-    def _cmd_model(self: Session, cmd: Command) -> None:
-        name = cmd.args[0]
-        self.settings = self._default_settings(name, self.settings.shadow, self.settings.speed)
-        self._init_live(name)
-
-    def _cmd_preset(self: Session, cmd: Command) -> None:
-        name = cmd.args[0]
-        self.worker.submit("preset", (self.epoch, name), lambda: _build_preset(name))
-        self._notify("Loading preset", f"{name}: {SCENARIOS[name].description}", cmd.client, "info")
+@dataclass(frozen=True, kw_only=True)
+class Command:
+    client: int | None = None  # viser client id of the sender (None: the server itself)
+    received: float = field(default_factory=time.perf_counter)  # s, when the input arrived
 
 
-def _build_preset(name: str) -> tuple[Simulator, Simulator]:
-    """The preset's operated run and a second copy for the shadow (suppression flipped on adoption)."""
-    scenario = SCENARIOS[name]
-    return scenario.build(), scenario.build()
+def _switch(name: str, value: Any) -> None:
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"{name} must be on or off, got {value!r}")
+
+
+def _finite(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Pause(Command):
+    pass
+
+
+@dataclass(frozen=True)
+class Resume(Command):
+    pass
+
+
+@dataclass(frozen=True)
+class SingleStep(Command):
+    count: int = 1  # simulation steps of 1 ms
+
+    def __post_init__(self) -> None:
+        if isinstance(self.count, bool) or not isinstance(self.count, int) or not 1 <= self.count <= 100_000:
+            raise ValueError(f"step count must be a whole number from 1 to 100000, got {self.count!r}")
+
+
+@dataclass(frozen=True)
+class Reset(Command):
+    pass
+
+
+@dataclass(frozen=True)
+class SetSpeed(Command):
+    speed: float  # simulated seconds per wall second
+
+    def __post_init__(self) -> None:
+        if self.speed not in SPEEDS:
+            raise ValueError(f"speed must be one of {', '.join(f'{s:g}' for s in SPEEDS)}, got {self.speed!r}")
+
+
+@dataclass(frozen=True)
+class Kick(Command):
+    peak: float  # N, half-sine peak along the base's first coordinate
+
+    def __post_init__(self) -> None:
+        if abs(_finite("kick peak", self.peak)) > MAX_KICK_N:
+            raise ValueError(f"kick peak must be a force of at most {MAX_KICK_N:g} N, got {self.peak}")
+
+
+@dataclass(frozen=True)
+class SetSuppression(Command):
+    on: bool  # vibration suppression (the g_b term) in the operated run; the shadow gets the opposite
+
+    def __post_init__(self) -> None:
+        _switch("vibration suppression", self.on)
+
+
+@dataclass(frozen=True)
+class SetLaw(Command):
+    law: LawKind
+
+    def __post_init__(self) -> None:
+        if self.law not in LIVE_LAWS:
+            raise ValueError(f"law must be one of {', '.join(LIVE_LAWS)}, got {self.law!r}")
+
+
+@dataclass(frozen=True)
+class SetGains(Command):
+    """Gains by name (g_b, g_m, G_p, G_d, k_p, k_d, servo_bandwidth), units of :class:`Gains`."""
+
+    changes: MappingProxyType[str, float]
+
+    def __post_init__(self) -> None:
+        unknown = set(self.changes) - GAIN_NAMES
+        if unknown:
+            raise InvalidGain(f"unknown gain(s): {', '.join(sorted(unknown))}")
+        Gains(**self.changes)  # each value: finite, within its range (InvalidGain otherwise)
+        object.__setattr__(self, "changes", MappingProxyType(dict(self.changes)))
+
+    def applied_to(self, gains: Gains) -> Gains:
+        return Gains(**{**{f.name: getattr(gains, f.name) for f in fields(Gains)}, **self.changes})
+
+
+@dataclass(frozen=True)
+class SetUbarSpeed(Command):
+    value: float  # 1/(kg m s): u-bar when scrubbing, dragging and in cyclic motion (1-D RNS)
+
+    def __post_init__(self) -> None:
+        if not 0 < _finite("u-bar speed", self.value) <= MAX_UBAR_SPEED:
+            raise InvalidGain(f"u-bar speed must be a positive number up to {MAX_UBAR_SPEED:g} 1/(kg m s)")
+
+
+@dataclass(frozen=True)
+class SetTargetSpeed(Command):
+    value: float  # m/s: speed limit of the smoothed target (multi-dimensional RNS)
+
+    def __post_init__(self) -> None:
+        if not 0 < _finite("target speed", self.value) <= MAX_TARGET_SPEED:
+            raise InvalidGain(f"target speed must be a positive number of m/s up to {MAX_TARGET_SPEED:g}")
+
+
+@dataclass(frozen=True)
+class SetShadow(Command):
+    on: bool
+
+    def __post_init__(self) -> None:
+        _switch("shadow run", self.on)
+
+
+@dataclass(frozen=True)
+class DragTarget(Command):
+    xy: tuple[float, float]  # m, base frame
+    final: bool = False  # the end of a drag
+
+    def __post_init__(self) -> None:
+        try:
+            xy = np.asarray(self.xy, dtype=float).reshape(-1)[:2]
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"target must be two numbers (m), got {self.xy!r}") from exc
+        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or float(np.max(np.abs(xy))) > MAX_TARGET_M:
+            raise ValueError(f"target must be two finite coordinates within {MAX_TARGET_M:g} m, got {self.xy!r}")
+        _switch("end of drag", self.final)
+        object.__setattr__(self, "xy", (float(xy[0]), float(xy[1])))
+
+
+@dataclass(frozen=True)
+class Scrub(Command):
+    sigma: float  # 1/(kg m): position along the current reactionless path (integral of u-bar dt)
+
+    def __post_init__(self) -> None:
+        _finite("path position", self.sigma)
+
+
+@dataclass(frozen=True)
+class Play(Command):
+    duration: float  # s: quintic u-bar to the other end of the path (Fig. 11)
+
+    def __post_init__(self) -> None:
+        if not _finite("duration", self.duration) > 0:
+            raise ValueError(f"duration must be positive, got {self.duration}")
+
+
+@dataclass(frozen=True)
+class Cyclic(Command):
+    on: bool  # cyclic motion along a closed path (Fig. 12)
+
+    def __post_init__(self) -> None:
+        _switch("cyclic motion", self.on)
+
+
+@dataclass(frozen=True)
+class PointToPoint(Command):
+    pass  # joint-space quintic to the end point of Play (Fig. 11(b))
+
+
+@dataclass(frozen=True)
+class SwitchModel(Command):
+    model: str
+
+    def __post_init__(self) -> None:
+        if self.model not in MODEL_NAMES:
+            raise ValueError(f"unknown model {self.model!r}; choose one of {', '.join(MODEL_NAMES)}")
+
+
+@dataclass(frozen=True)
+class LoadPreset(Command):
+    name: str
+
+    def __post_init__(self) -> None:
+        if self.name not in SCENARIOS:
+            raise ValueError(f"unknown preset {self.name!r}; choose one of {', '.join(SCENARIOS)}")
+
+
+# Operator inputs whose arrival-to-first-step latency is measured.
+TIMED = (
+    Kick,
+    SetSuppression,
+    SetLaw,
+    SetGains,
+    SetUbarSpeed,
+    SetTargetSpeed,
+    DragTarget,
+    Scrub,
+    Play,
+    Cyclic,
+    PointToPoint,
+)

@@ -1,6 +1,10 @@
 """What the operator drives in live mode: the joint reference (and, for a multi-dimensional RNS, the
 end-effector reference) that the operated and the shadow law both follow.
 
+The operator owns its references and hands out immutable samples (:attr:`Operator.joint`,
+:attr:`Operator.task`), which the loop passes to both laws at every step; :meth:`Operator.advance`
+returns what changed for the loop to act on.
+
 1-D RNS (TREP): theta_ref lives on the current reactionless path (:class:`PathTable`); drags, the
 scrub slider, quintic plays and cyclic motion all move sigma = integral of u-bar dt (Eq. 30); the
 point-to-point comparison leaves the path on a joint-space quintic between the same end points.
@@ -11,22 +15,28 @@ followed by the :class:`ResolvedRate` reference.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from rns_viz.control import JointSample, TaskSample
 from rns_viz.live.path_table import PathTable
 from rns_viz.live.reach import ReachRegion
-from rns_viz.live.references import (
-    LiveJointReference,
-    LiveTaskTarget,
-    PathFollower,
-    ResolvedRate,
-    SigmaMotion,
-)
+from rns_viz.live.references import PathFollower, ResolvedRate, SigmaMotion
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import QuinticSegment
+from rns_viz.scenarios import FIG11_FAST_S
 
-FIG11_SLOW_S = 5.0  # s, as scenarios.FIG11_SLOW_S
-FIG11_FAST_S = 2.5  # s
+
+@dataclass(frozen=True)
+class OperatorChange:
+    """What one :meth:`Operator.advance` changed that the loop must act on."""
+
+    joint_move_changed: bool = False  # a point-to-point move started or ended: other laws apply
+    target_jumped: bool = False  # the target moved other than by a drag: the handle follows it
+
+
+UNCHANGED = OperatorChange()
 
 
 class InputRefused(ValueError):
@@ -41,25 +51,24 @@ class Operator:
         self.rns_dim = model.n - len(model.selected)
         self.on_path = self.rns_dim == 1
         theta0 = np.array(theta0, dtype=float)
-        self.ref = LiveJointReference(theta0)
+        self.joint = JointSample.held(theta0)  # theta_ref with its rates, for the laws
         self.ee_z = float(model.ee_position(theta0)[2])
         self.target: np.ndarray | None = None  # where the arm is going, base frame (m)
         self.target_raw: np.ndarray | None = None  # where the operator put the target
         self.table: PathTable | None = None
         self.reach: ReachRegion | None = None
         self.joint_move: QuinticSegment | None = None
-        self.task: LiveTaskTarget | None = None
+        self.task: TaskSample | None = None  # x_d with its rates (multi-dimensional RNS), for the laws
         self.mode = "holding"
         if self.on_path:
             self.follower = PathFollower(model, theta0)
             self.motion = SigmaMotion(0.0, ubar_speed)
         else:
             self.rr = ResolvedRate(model, theta0, v_max=target_speed)
-            self.task = LiveTaskTarget(self.rr.x.copy())
+            self.task = TaskSample.held(self.rr.x)
             self.target = self._point(self.rr.x)
         self._moving = False
-        self.joint_move_changed = False  # set when a point-to-point move starts or ends
-        self.target_jumped = False  # set when the target moved other than by a drag (the handle follows)
+        self._joint_move_started = False
         self.dragging = False
 
     # -- state ---------------------------------------------------------------------------------
@@ -98,7 +107,7 @@ class Operator:
     def re_anchor(self, theta: np.ndarray) -> None:
         """Hold at ``theta`` (the arm's configuration) from now on; forgets the path table."""
         theta = np.array(theta, dtype=float)
-        self.ref.hold(theta)
+        self.joint = JointSample.held(theta)
         self.joint_move = None
         if self.on_path:
             self.follower.reset(theta)
@@ -106,9 +115,7 @@ class Operator:
             self.table = None
         else:
             self.rr.reset(theta)
-            task = self.task
-            assert task is not None  # the laws hold this object: update it in place
-            task.x, task.xdot, task.xddot = self.rr.x.copy(), np.zeros_like(self.rr.x), np.zeros_like(self.rr.x)
+            self.task = TaskSample.held(self.rr.x)
             self.target = self._point(self.rr.x)  # the old reachable set serves until the new one is in
         self.mode = "holding"
 
@@ -192,52 +199,51 @@ class Operator:
         start = self.follower.theta.copy()
         end = self.follower.end_point(total)
         self.joint_move = QuinticSegment(start, end, duration, t0=t)
-        self.joint_move_changed = True
+        self._joint_move_started = True
         self._after_move = self.motion.sigma + total
         self.target = self._point(self.table.ee_at(self._after_move))  # type: ignore[union-attr]
         self.mode = "point-to-point (same end points)"
 
     # -- per step --------------------------------------------------------------------------------
-    def advance(self, t: float, dt: float) -> None:
+    def advance(self, t: float, dt: float) -> OperatorChange:
         """Set the references for time t (call once, before the simulation step at t)."""
         if not self.on_path:
             rr = self.rr
             was_idle = rr.idle
             rr.step(dt)
             if not rr.idle or not was_idle:
-                self.ref.set(rr.theta, rr.thetadot, np.zeros_like(rr.thetadot))
-                task = self.task
-                assert task is not None
-                task.x, task.xdot, task.xddot = rr.x, rr.xdot, rr.xddot
+                self.joint = JointSample(rr.theta, rr.thetadot, np.zeros_like(rr.thetadot))
+                self.task = TaskSample(rr.x, rr.xdot, rr.xddot)
                 if rr.idle:
                     self.mode = "holding at the target"
-            return
+            return UNCHANGED
         if self.joint_move is not None:
+            started, self._joint_move_started = self._joint_move_started, False
             seg = self.joint_move
-            theta, thetadot, thetaddot = seg(t)
-            self.ref.set(theta, thetadot, thetaddot)
-            if t >= seg.t0 + seg.duration:
-                self.follower.reset(seg.end)
-                self.ref.hold(seg.end)
-                if self.table is not None:
-                    self.motion.rebase(self._after_move)
-                self.joint_move = None
-                self.joint_move_changed = True
-                self.mode = "holding"
-            return
+            self.joint = JointSample(*seg(t))
+            if t < seg.t0 + seg.duration:
+                return OperatorChange(joint_move_changed=True) if started else UNCHANGED
+            self.follower.reset(seg.end)
+            self.joint = JointSample.held(seg.end)
+            if self.table is not None:
+                self.motion.rebase(self._after_move)
+            self.joint_move = None
+            self.mode = "holding"
+            return OperatorChange(joint_move_changed=not started)
         motion = self.motion
         if motion.moving:
             before = motion.sigma
             motion.step(t - dt, dt)
             self.follower.advance(motion.sigma - before)
-            self.ref.set(*self.follower.reference(motion.ubar, dt))
+            self.joint = JointSample(*self.follower.reference(motion.ubar, dt))
             self._moving = True
             if not motion.moving:
                 self.mode = "holding"
                 if self.table is not None and not self.dragging:
                     self.target = self._point(self.table.ee_at(motion.sigma))
-                    self.target_jumped = True
+                    return OperatorChange(target_jumped=True)
         elif self._moving:
             self._moving = False
             self.follower.reference(0.0, dt)
-            self.ref.hold(self.follower.theta)
+            self.joint = JointSample.held(self.follower.theta)
+        return UNCHANGED

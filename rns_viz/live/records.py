@@ -7,12 +7,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Literal, NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 
-from rns_viz.control import Gains
-from rns_viz.live.laws import LawKind
+from rns_viz.control import Gains, LawKind
 
 Level = Literal["info", "warning", "error"]
 
@@ -24,13 +23,6 @@ class Notice(NamedTuple):
     body: str
     client: int | None
     level: Level
-
-
-class Command(NamedTuple):
-    kind: str
-    args: tuple[Any, ...]
-    client: int | None
-    received: float  # time.perf_counter() when the input arrived
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,8 @@
 """References the operator moves while the simulation runs; the session advances them once per step.
 
-Both the operated and the shadow run's laws read the same reference objects, so the shadow sees the
-same operator inputs. Every reference is advanced by the session *before* the step at time t, and
-the laws then read it at t.
+The operator (rns_viz.live.operator) advances them once *before* the step at time t and hands
+immutable samples of them to both runs' laws, so the shadow sees the same operator inputs.
 
-- :class:`LiveJointReference` / :class:`LiveTaskTarget`: theta_ref and x_d with their rates, as the
-  laws' JointReference / TaskReference protocols want them.
 - :class:`SigmaMotion`: sigma = integral of u-bar dt (Eq. 30) held, driven to a goal (scrub, drag),
   by a quintic (Fig. 11) or cyclically (Fig. 12).
 - :class:`PathFollower`: theta_ref on the reactionless path, d theta / d sigma = n(theta) by RK4.
@@ -16,59 +13,14 @@ the laws then read it at t.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 import pinocchio as pin
 
-from rns_viz.live.dls import damped_inverse as _damped_inverse
 from rns_viz.live.follower import Follower, ScalarFollower
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic
-from rns_viz.rns import damped_pinv, null_vector
-
-
-@dataclass
-class LiveJointReference:
-    """theta_ref(t), its rate and acceleration as last set by the session (rad, rad/s, rad/s^2)."""
-
-    theta: np.ndarray
-    thetadot: np.ndarray = field(default=None)  # type: ignore[assignment]
-    thetaddot: np.ndarray = field(default=None)  # type: ignore[assignment]
-
-    def __post_init__(self) -> None:
-        self.theta = np.array(self.theta, dtype=float)
-        zero = np.zeros_like(self.theta)
-        self.thetadot = zero if self.thetadot is None else self.thetadot
-        self.thetaddot = zero.copy() if self.thetaddot is None else self.thetaddot
-
-    def set(self, theta: np.ndarray, thetadot: np.ndarray, thetaddot: np.ndarray) -> None:
-        self.theta, self.thetadot, self.thetaddot = theta, thetadot, thetaddot
-
-    def hold(self, theta: np.ndarray) -> None:
-        zero = np.zeros_like(theta)
-        self.set(np.array(theta, dtype=float), zero, zero)
-
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return self.theta, self.thetadot, self.thetaddot
-
-
-@dataclass
-class LiveTaskTarget:
-    """x_d(t), x_d', x_d'' in the base frame (task rows), as last set by the session (m, m/s, m/s^2)."""
-
-    x: np.ndarray
-    xdot: np.ndarray = field(default=None)  # type: ignore[assignment]
-    xddot: np.ndarray = field(default=None)  # type: ignore[assignment]
-
-    def __post_init__(self) -> None:
-        self.x = np.array(self.x, dtype=float)
-        self.xdot = np.zeros_like(self.x) if self.xdot is None else self.xdot
-        self.xddot = np.zeros_like(self.x) if self.xddot is None else self.xddot
-
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return self.x, self.xdot, self.xddot
+from rns_viz.rns import damped_pinv, null_vector, rns_projector
 
 
 class SigmaMotion:
@@ -164,7 +116,6 @@ class PathFollower:
         self.data = model.pin_model.createData()
         self.field = CouplingField(model)
         self._q = np.zeros(model.nv)
-        self._planar_pair = model.n == 2 and len(model.selected) == 1 and model.selected[0] == 0
         self.project_every = project_every
         self.reset(theta)
 
@@ -180,8 +131,6 @@ class PathFollower:
         m = self.model.m
         self._q[m:] = theta
         M = pin.crba(self.model.pin_model, self.data, self._q)
-        if self._planar_pair:  # Eq. (27): n = (h_2, -h_1)
-            return np.array([M[0, m + 1], -M[0, m]])
         return null_vector(M[self.model.selected, m:])
 
     def advance(self, dsigma: float) -> None:
@@ -267,7 +216,6 @@ class ResolvedRate:
         self.stop_sigma = stop_sigma  # m/rad: no motion that lowers sigma_min(J-bar) below this
         self.joint_speed = joint_speed  # rad/s: |theta_ref'| at most
         self.blocked = False
-        self._eye = np.eye(model.n)
         self.rows = model.task_rows
         self.follower = Follower(np.zeros(len(self.rows)), v_max)
         self.reset(theta)
@@ -288,12 +236,7 @@ class ResolvedRate:
 
     def _projector(self, q: np.ndarray) -> np.ndarray:
         """P_RNS at q, from S H_bm."""
-        m = self.model.m
-        H = pin.crba(self.model.pin_model, self.data, q)[self.model.selected, m:]
-        if H.shape[0] == 1:
-            h = H[0]
-            return self._eye - np.outer(h, h) / max(float(h @ h), 1e-300)
-        return self._eye - damped_pinv(H, 1e-9, 1e-9).inverse @ H
+        return rns_projector(pin.crba(self.model.pin_model, self.data, q)[self.model.selected, self.model.m :])
 
     def _sigma_at(self, theta: np.ndarray) -> float:
         """The distance to singularity of J-bar at theta (m/rad)."""
@@ -301,7 +244,7 @@ class ResolvedRate:
         q = np.concatenate([np.zeros(m), theta])
         J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
         J = (data.oMi[self.model.base_joint_id].rotation.T @ J_world)[self.rows]
-        return _damped_inverse(J @ self._projector(q), self.threshold)[1]
+        return damped_pinv(J @ self._projector(q), self.threshold, self.threshold).sigma_min
 
     def ee(self, theta: np.ndarray) -> np.ndarray:
         pm, data, m = self.model.pin_model, self.data, self.model.m
@@ -343,8 +286,9 @@ class ResolvedRate:
             f.v = np.zeros_like(f.v)
             at_goal = False
         P = self._projector(q)
-        inverse, self.sigma_jbar = _damped_inverse(J @ P, self.threshold)
-        thetadot = P @ (inverse @ (f.v + self.k * (f.x - x)))
+        inverse = damped_pinv(J @ P, self.threshold, self.threshold)
+        self.sigma_jbar = inverse.sigma_min
+        thetadot = P @ (inverse.inverse @ (f.v + self.k * (f.x - x)))
         speed = float(np.sqrt(thetadot @ thetadot))
         if speed > self.joint_speed:
             thetadot *= self.joint_speed / speed

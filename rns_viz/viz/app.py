@@ -22,11 +22,13 @@ from typing import Any
 import numpy as np
 import viser
 
-from rns_viz.live.laws import LAW_KINDS, LAW_LABELS
+from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
+from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.operator_lock import OperatorLock
 from rns_viz.live.pacing import SPEEDS
+from rns_viz.live.records import Notice, Snapshot
+from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
-from rns_viz.session import Notice, Session, Snapshot
 from rns_viz.viz.gui import (
     EXAGGERATION,
     KICK_RANGE,

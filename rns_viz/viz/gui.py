@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import viser
 import viser.uplot
 
-from rns_viz.live.laws import LAW_KINDS, LAW_LABELS
-from rns_viz.live.operator import FIG11_FAST_S, FIG11_SLOW_S
+from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
+from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
-from rns_viz.scenarios import SCENARIOS
+from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, SCENARIOS
 
 MODEL_LABELS = {"trep": "TREP (2R on a flexible beam)", "planar3r": "planar 3R on a spring"}
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}

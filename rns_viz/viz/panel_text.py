@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from rns_viz.session import Snapshot
+from rns_viz.live.records import Snapshot
 
 OK_COLOUR = "#1b7f3b"
 WARN_COLOUR = "#c77700"

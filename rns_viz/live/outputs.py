@@ -1,0 +1,92 @@
+"""What the live session publishes from the runs: plot samples, readouts and the arm's reaction.
+
+:class:`Outputs` is fed by the simulation loop after every step and read by any thread through the
+plot buffers and the latest :class:`~rns_viz.live.records.Readouts`. Units: the plots carry x_b in
+mm, L in kg m/s and the end-effector error in mm; readouts are SI.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rns_viz.control import ControlOutput
+from rns_viz.live.plots import PlotBuffers
+from rns_viz.live.readouts import compute_readouts
+from rns_viz.live.records import Readouts
+from rns_viz.live.runs import RunPair
+from rns_viz.model import FsmsModel
+
+PLOT_EVERY = 20  # steps between plot samples (50 Hz: a 10 s window is 500 samples)
+READOUT_EVERY = 50  # steps between readout updates (20 Hz)
+REACTION_TAU = 0.01  # s, low-pass of the reaction force shown by the arrow
+
+
+def reference_point(model: FsmsModel, out: ControlOutput | None) -> np.ndarray | None:
+    """Where the law sends the end effector (base frame x, y, m), or None without a reference."""
+    if out is None:
+        return None
+    if out.ee_ref is not None:
+        return np.asarray(out.ee_ref)[:2]
+    if out.theta_ref is not None:
+        return model.ee_position(out.theta_ref)[:2]
+    return None
+
+
+class Outputs:
+    def __init__(self, plot_capacity: int = 500) -> None:
+        self.plots = PlotBuffers(plot_capacity)
+        self.steps = 0  # steps booked since the session started (never reset: readers wait on it)
+        self.restart(None)
+
+    def restart(self, model: FsmsModel | None, q: np.ndarray | None = None) -> None:
+        """Forget history (reset, model switch, preset load)."""
+        self.plots.clear()
+        self.last: ControlOutput | None = None
+        self._last_L = 0.0
+        self.reaction = 0.0  # N: the arm's reaction on the base, -dL/dt, low-passed
+        self.ee_error = math.nan  # m
+        self.readouts = Readouts()
+        if model is not None and q is not None:
+            self._update_readouts(model, q)
+
+    def after_step(self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool) -> None:
+        """Book one step of the operated run (``model`` is the loop's own instance for kinematics)."""
+        self.steps += 1
+        dt = runs.sim.dt
+        L = float(out.coupling_momentum[0])
+        force = -(L - self._last_L) / dt if self.last is not None else 0.0
+        self._last_L = L
+        self.reaction += (force - self.reaction) * min(1.0, dt / REACTION_TAU)
+        self.last = out
+        if self.steps % PLOT_EVERY == 0:
+            self._sample_plots(model, runs, out, shadow_on)
+        if self.steps % READOUT_EVERY == 0:
+            self._update_readouts(model, runs.sim.q)
+
+    def _sample_plots(self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool) -> None:
+        sim, shadow = runs.sim, runs.shadow
+        x = model.ee_position(sim.q[model.m :])[:2]
+        ref = reference_point(model, out)
+        self.ee_error = float(np.linalg.norm(ref - x)) if ref is not None else math.nan
+        shadow_out = shadow.last if shadow_on else None
+        self.plots.append(
+            (
+                sim.t,
+                sim.q[0] * 1e3,
+                shadow.q[0] * 1e3 if shadow_on else math.nan,
+                L_of(out),
+                L_of(shadow_out) if shadow_out is not None else math.nan,
+                self.ee_error * 1e3,
+            )
+        )
+
+    def _update_readouts(self, model: FsmsModel, q: np.ndarray) -> None:
+        L = L_of(self.last) if self.last is not None else 0.0
+        self.readouts = compute_readouts(model, q, L, self.ee_error, self.reaction)
+
+
+def L_of(out: ControlOutput) -> float:
+    """The coupling momentum's first selected row, kg m/s (Eq. 8)."""
+    return float(out.coupling_momentum[0])

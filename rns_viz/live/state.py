@@ -1,0 +1,393 @@
+"""The state of a live session, owned by its simulation loop: one object, touched by one thread.
+
+:class:`LiveState` holds the settings, the run pair, the operator, the background jobs and the
+outputs. The loop calls :meth:`LiveState.apply` for each queued command (a ``match`` on its type),
+:meth:`LiveState.tick` for each step and :meth:`LiveState.collect` for finished background results;
+:meth:`LiveState.publish` makes the immutable snapshot readers take. Nothing here imports viser.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import replace
+
+import numpy as np
+
+from rns_viz.control import Gains, LawKind
+from rns_viz.defaults import defaults_for
+from rns_viz.live import commands as c
+from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
+from rns_viz.live.guard import GUARD_EVERY, Bounds
+from rns_viz.live.kicks import kick_pulse
+from rns_viz.live.operator import InputRefused, Operator
+from rns_viz.live.outputs import Outputs
+from rns_viz.live.pacing import Pacer
+from rns_viz.live.readouts import arm_reach
+from rns_viz.live.records import Level, Notice, Overlays, Settings, Snapshot
+from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
+from rns_viz.model import FsmsModel
+from rns_viz.paths import CouplingField
+from rns_viz.scenarios import SCENARIOS
+
+SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
+UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)
+TARGET_SPEED = 0.5  # m/s: default speed limit of the smoothed target
+
+
+def default_settings(model: str, shadow: bool, speed: float) -> Settings:
+    law = defaults_for(model).law
+    return Settings(model, law, defaults_for(model).gains_for(law), True, UBAR_SPEED, TARGET_SPEED, shadow, speed, None)
+
+
+class LiveState:
+    def __init__(self, model: str, shadow: bool, pacer: Pacer) -> None:
+        self.pacer = pacer
+        self.notices: deque[Notice] = deque(maxlen=100)
+        self.background = Background()
+        self.outputs = Outputs()
+        self._default_tables: dict[str, object] = {}
+        self._gain_memory: dict[tuple[str, LawKind], Gains] = {}
+        self.epoch = self.settings_version = self.target_version = self.overlay_version = 0
+        self.paused = False
+        self.diverged: str | None = None
+        self.settings = default_settings(model, shadow, pacer.speed)
+        self.aux: FsmsModel | None = None
+        self.start_live(model)
+
+    # ================================================================ set-up
+    def _use_model(self, name: str) -> None:
+        if self.aux is None or self.aux.name != name:
+            self.aux = FsmsModel.from_name(name)  # the loop's own model for references and readouts
+            self.field = CouplingField(self.aux)
+            self.bounds = Bounds(self.aux)
+            self.reach_m = arm_reach(self.aux)
+            self.tol = 1e-4 * self.aux.arm_mass * self.reach_m  # kg m: same level of the coupling potential
+
+    @property
+    def model(self) -> FsmsModel:
+        assert self.aux is not None
+        return self.aux
+
+    def _choice(self) -> LawChoice:
+        st = self.settings
+        return LawChoice(st.law, st.gains, st.suppress)
+
+    def start_live(self, name: str) -> None:
+        """A fresh live run of model ``name`` at its default configuration, at rest, t = 0."""
+        self._use_model(name)
+        theta0 = self.model.spec.default_configuration
+        self.runs = RunPair.at_rest(name, theta0)
+        self._new_operator(theta0)
+        self.settings = replace(self.settings, preset=None)
+        self._restart_bookkeeping()
+        op = self.operator
+        assert op is not None
+        if op.on_path:
+            table = self._default_tables.get(name)
+            if table is None or not op.accept_table(table, self.tol):  # type: ignore[arg-type]
+                self._request_geometry(theta0, default=True)
+            else:
+                self._current_path = table.ee  # type: ignore[attr-defined]
+            self.background.family(self.epoch, name)
+        else:
+            self._request_geometry(theta0)
+        self._overlays_changed()
+
+    def _new_operator(self, theta: np.ndarray) -> None:
+        st = self.settings
+        self.operator: Operator | None = Operator(self.model, theta, st.ubar_speed, st.target_speed)
+        self._install_live_laws()
+
+    def _install_live_laws(self) -> None:
+        op = self.operator
+        assert op is not None
+        self.runs.install(self._choice(), op.joint, op.task if not op.on_path else None, op.joint_move is not None)
+
+    def _restart_bookkeeping(self) -> None:
+        self.epoch += 1
+        self.settings_version += 1
+        self.target_version += 1
+        self.paused = False
+        self.diverged = None
+        self.pacer.reanchor(self.runs.t)
+        self._reach_points: np.ndarray | None = None
+        self._current_path: np.ndarray | None = None
+        self._shown_level: np.ndarray | None = None
+        self.outputs.restart(self.model, self.runs.sim.q)
+
+    def _go_live(self) -> Operator:
+        """The operator; after a preset, live laws holding the current configuration first."""
+        if self.operator is None:
+            self.hold_here()
+        assert self.operator is not None
+        return self.operator
+
+    def hold_here(self) -> None:
+        """Live laws from the current state, holding the current configuration (leaves a preset)."""
+        theta = self.runs.theta.copy()
+        self.runs.leave_preset_forces()
+        self._new_operator(theta)
+        self.settings = replace(self.settings, preset=None)
+        self.settings_version += 1
+        self.target_version += 1
+        self._request_geometry(theta)
+
+    def _adopt_preset(self, name: str, runs: RunPair) -> None:
+        self._use_model(SCENARIOS[name].model)
+        self.runs, self.operator = runs, None
+        choice = runs.adopt_preset_laws()
+        st = self.settings
+        self.settings = replace(
+            default_settings(self.model.name, st.shadow, st.speed),
+            law=choice.kind,
+            gains=choice.gains,
+            suppress=choice.suppress,
+            preset=name,
+        )
+        self._restart_bookkeeping()
+        self._request_geometry(runs.theta)
+        if self._one_dim:
+            self.background.family(self.epoch, self.model.name)
+        self._overlays_changed()
+
+    @property
+    def _one_dim(self) -> bool:
+        return self.model.n - len(self.model.selected) == 1
+
+    def _request_geometry(self, theta: np.ndarray, default: bool = False) -> None:
+        """The current reactionless path (1-D RNS) or reachable set (otherwise) through ``theta``."""
+        self._shown_level = self.field.potentials(np.asarray(theta, dtype=float)[None])[0]
+        if self._one_dim:
+            self.background.path_table(self.epoch, self.model.name, theta, default)
+        else:
+            self.background.reach(self.epoch, self.model.name, theta)
+
+    def notify(self, title: str, body: str, client: int | None = None, level: Level = "info") -> None:
+        self.notices.append(Notice(title, body, client, level))
+
+    def fail(self, why: str) -> None:
+        self.paused = True
+        self.diverged = why
+        self.notify("Simulation stopped", f"{why}. Press Reset to start again.", None, "error")
+
+    # ================================================================ commands
+    def apply(self, cmd: c.Command) -> None:
+        """Apply one command; InputRefused/ValueError leave everything as it was and tell the sender."""
+        try:
+            self._apply(cmd)
+        except ValueError as exc:  # InputRefused included
+            self.notify("Input not applied", str(exc), cmd.client, "warning")
+            self.settings_version += 1  # the GUI shows the values actually in force
+
+    def _apply(self, cmd: c.Command) -> None:
+        st = self.settings
+        match cmd:
+            case c.Pause():
+                self.paused = True
+            case c.Resume():
+                if self.diverged:
+                    raise InputRefused(f"the simulation stopped ({self.diverged}); press Reset to start again")
+                self.paused = False
+                self.pacer.reanchor(self.runs.t)
+            case c.SingleStep(count=count):
+                self.paused = True
+                for _ in range(count):
+                    if self.diverged:
+                        break
+                    self.tick()
+            case c.Reset():
+                if st.preset is not None:
+                    self._apply(c.LoadPreset(st.preset, client=cmd.client))
+                else:
+                    self.start_live(st.model)
+            case c.SetSpeed(speed=speed):
+                self.pacer.set_speed(speed, self.runs.t)
+                self.settings = replace(st, speed=speed)
+            case c.Kick(peak=peak):
+                duration = defaults_for(st.model).kick_duration_s
+                self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m))
+            case c.SetSuppression(on=on):
+                self.runs.set_suppression(on)
+                self.settings = replace(st, suppress=on)
+            case c.SetLaw(law=law):
+                self._gain_memory[(st.model, st.law)] = st.gains
+                gains = self._gain_memory.get((st.model, law), defaults_for(st.model).gains_for(law))
+                self.settings = replace(st, law=law, gains=gains)
+                if self.operator is None:
+                    self._go_live()
+                else:
+                    self._install_live_laws()
+                self.settings_version += 1
+            case c.SetGains():
+                gains = cmd.applied_to(st.gains)
+                self.runs.retune(gains)
+                self.settings = replace(st, gains=gains)
+            case c.SetUbarSpeed(value=value) | c.SetTargetSpeed(value=value):
+                field = "ubar_speed" if isinstance(cmd, c.SetUbarSpeed) else "target_speed"
+                self.settings = replace(st, **{field: value})
+                if self.operator is not None:
+                    self.operator.set_speeds(self.settings.ubar_speed, self.settings.target_speed)
+            case c.SetShadow(on=on):
+                if on and not st.shadow:
+                    self.runs.resync_shadow()
+                self.settings = replace(st, shadow=on)
+            case c.DragTarget(xy=xy, final=final):
+                self._drag(np.array(xy), final, cmd.client)
+            case c.Scrub(sigma=sigma):
+                self._go_live().scrub(sigma)
+                self.target_version += 1
+            case c.Play(duration=duration):
+                self._go_live().play(self.runs.t, duration)
+                self.target_version += 1
+            case c.Cyclic(on=on):
+                self._go_live().cyclic(self.runs.t, on, st.ubar_speed)
+            case c.PointToPoint():
+                self._go_live().point_to_point(self.runs.t)
+                self.target_version += 1
+            case c.SwitchModel(model=name):
+                self.settings = default_settings(name, st.shadow, st.speed)
+                self.start_live(name)
+            case c.LoadPreset(name=name):
+                self.background.preset(self.epoch, name)
+                self.notify("Loading preset", f"{name}: {SCENARIOS[name].description}", cmd.client, "info")
+            case _:
+                raise TypeError(f"unknown command {cmd!r}")
+
+    def _drag(self, xy: np.ndarray, final: bool, client: int | None) -> None:
+        op = self._go_live()
+        moved = op.drag(xy, final)
+        if final:
+            self.target_version += 1
+            if moved:
+                x, y = op.target[:2]  # type: ignore[index]
+                self.notify(
+                    "Target clamped",
+                    f"That target is outside the set reachable without reaction from this configuration; "
+                    f"the arm goes to the nearest reachable point ({x:.2f}, {y:.2f}) m instead.",
+                    client,
+                    "warning",
+                )
+
+    # ================================================================ steps
+    def tick(self) -> bool:
+        """One simulation step; False if the simulation stopped (diverged or left physical bounds)."""
+        runs, op = self.runs, self.operator
+        t = runs.t
+        if op is not None:
+            change = op.advance(t, runs.sim.dt)
+            if change.joint_move_changed:
+                self._install_live_laws()
+            if change.target_jumped:
+                self.target_version += 1
+        shadow_on = self.settings.shadow
+        try:
+            out = runs.step(op.joint if op else None, op.task if op else None, shadow_on)
+        except ShadowDiverged as exc:
+            out = runs.sim.last
+            runs.resync_shadow()
+            self.notify("Shadow run restarted", str(exc), None, "warning")
+        except Exception as exc:  # SimulationDiverged or a law's error: the last finite state is kept
+            self.fail(f"the simulation diverged at t = {t:.3f} s ({exc})")
+            return False
+        assert out is not None
+        self.outputs.after_step(self.model, runs, out, shadow_on)
+        k = self.outputs.steps
+        if k % GUARD_EVERY == 0 and self._out_of_bounds():
+            return False
+        if k % SETTLE_EVERY == 0:
+            self._check_settled()
+        return True
+
+    def _out_of_bounds(self) -> bool:
+        """Stop with a message if the operated run left physical bounds; restart a stray shadow run."""
+        sim, shadow = self.runs.sim, self.runs.shadow
+        why = self.bounds.violation(sim.q, sim.v)
+        if why is not None:
+            self.fail(f"the simulation left physical bounds at t = {sim.t:.3f} s: {why}")
+            return True
+        if self.settings.shadow:
+            why = self.bounds.violation(shadow.q, shadow.v)
+            if why is not None:
+                self.runs.resync_shadow()
+                msg = f"the shadow run left physical bounds ({why}); restarted from the operated state"
+                self.notify("Shadow run restarted", msg, None, "warning")
+        return False
+
+    def _check_settled(self) -> None:
+        """Once the arm rests on another level of the coupling potential (e.g. after law (15) absorbed a
+        kick), re-anchor the reference there and recompute the current path / reachable set."""
+        sim, op, m = self.runs.sim, self.operator, self.runs.model.m
+        if float(np.max(np.abs(sim.v))) > 1e-3 or float(np.max(np.abs(sim.q[:m]))) > 1e-5 * self.reach_m:
+            return
+        if op is not None and (op.busy or self.settings.law == "velocity"):
+            return  # (30) pulls the arm back to theta_ref in every direction: nothing to re-anchor
+        theta = sim.q[m:].copy()
+        level = self.field.potentials(theta[None])[0]
+        reference_level = op.level if op is not None else self._shown_level
+        if reference_level is None or float(np.max(np.abs(level - reference_level))) <= self.tol:
+            return
+        if op is not None:
+            op.re_anchor(theta)
+            self.target_version += 1
+        self._request_geometry(theta)
+
+    # ================================================================ background results
+    def collect(self) -> None:
+        for ready in self.background.results(self.epoch):
+            match ready:
+                case JobFailed(kind=kind, error=error):
+                    self.notify("Background computation failed", f"{kind}: {error}", None, "warning")
+                case PresetReady(name=name, sims=sims):
+                    self._adopt_preset(name, RunPair(*sims))
+                case FamilyReady():
+                    self._overlays_changed()
+                case TableReady(table=table, default=default):
+                    if default:
+                        self._default_tables[self.model.name] = table
+                    op = self.operator
+                    if op is not None and not op.accept_table(table, self.tol):
+                        self._request_geometry(op.theta_ref)  # theta_ref moved to another path meanwhile
+                        continue
+                    self._current_path = table.ee
+                    self._overlays_changed()
+                case ReachReady(region=region):
+                    if self.operator is not None and not self.operator.on_path:
+                        self.operator.reach = region
+                    self._reach_points = region.points
+                    self._overlays_changed()
+
+    # ================================================================ outputs
+    def _overlays_changed(self) -> None:
+        self.overlay_version += 1
+        family = self.background.families.get(self.model.name)
+        self.overlays = Overlays(family, self._current_path, self._reach_points, self.overlay_version)
+
+    def publish(self, realtime: bool) -> Snapshot:
+        sim, op, out = self.runs.sim, self.operator, self.outputs
+        table = op.table if op is not None and op.on_path else None
+        mode, target = (op.mode, op.target) if op is not None else (f"preset {self.settings.preset}", None)
+        readouts = replace(out.readouts, reaction=out.reaction)
+        shadow_on = self.settings.shadow
+        return Snapshot(
+            epoch=self.epoch,
+            settings=self.settings,
+            settings_version=self.settings_version,
+            steps=out.steps,
+            t=sim.t,
+            q=sim.q.copy(),
+            q_shadow=self.runs.shadow.q.copy() if shadow_on else None,
+            paused=self.paused,
+            diverged=self.diverged,
+            rtf=0.0 if self.paused else self.pacer.rtf() if realtime else math.nan,
+            behind=realtime and not self.paused and self.pacer.behind(),
+            mode="paused" if self.paused and not self.diverged else mode,
+            target=None if target is None else target.copy(),
+            target_version=self.target_version,
+            sigma=op.sigma if op is not None else None,
+            sigma_range=None
+            if table is None
+            else ((-0.5 * table.period, 0.5 * table.period) if table.closed else (table.lo, table.hi)),
+            readouts=readouts,
+            overlay_version=self.overlay_version,
+        )
