@@ -7,7 +7,7 @@ current epoch only: a result computed for a model or preset that has since been 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,15 +82,16 @@ class Background:
     def has_results(self) -> bool:
         return self.worker.has_results()
 
-    def results(self, epoch: int) -> Iterator[Ready]:
-        """Finished results for ``epoch`` (families for any), oldest first; failures as :class:`JobFailed`."""
+    def results(self, epoch: Callable[[], int]) -> Iterator[Ready]:
+        """Finished results of the current ``epoch()`` (families for any), oldest first; failures as
+        :class:`JobFailed`. The epoch is read for each result: taking one may start a new epoch."""
         for res in self.worker.collect():
             if res.error is not None:
                 yield JobFailed(res.kind, res.error)
             elif res.kind == "family":
                 self.families[res.tag[1]] = res.value
                 yield FamilyReady(res.tag[1], res.value)
-            elif res.tag[0] != epoch:
+            elif res.tag[0] != epoch():
                 continue
             elif res.kind == "table":
                 yield TableReady(res.value, res.tag[1])

@@ -39,8 +39,15 @@ class OperatorChange:
 UNCHANGED = OperatorChange()
 
 
+SNAP_TOLERANCE_M = 0.005  # m: a dragged target farther than this from the current path is said to be moved
+
+
 class InputRefused(ValueError):
     """An operator input that cannot be applied now; the message says why (shown to that client)."""
+
+
+class PathNotReady(InputRefused):
+    """The current reactionless path is still being computed: the input can wait for it."""
 
 
 class Operator:
@@ -130,13 +137,19 @@ class Operator:
     # -- operator inputs -----------------------------------------------------------------------
     def _need_table(self) -> PathTable:
         if self.table is None:
-            raise InputRefused("The reactionless path through the current configuration is still being computed.")
+            raise PathNotReady("The reactionless path through the current configuration is still being computed.")
         if self.joint_move is not None:
             raise InputRefused("Wait until the point-to-point comparison motion has finished.")
+        if len(self.table.sigma) < 2:
+            raise InputRefused(
+                "The arm is at a singularity of the coupling H_bm (no reactionless path passes here); "
+                "kick the base or press Reset to leave it."
+            )
         return self.table
 
     def drag(self, point: np.ndarray, final: bool = True) -> bool:
-        """Send the arm toward a target (x, y) in the base frame; True if the target had to be moved.
+        """Send the arm toward a target (x, y) in the base frame; True if the target had to be moved
+        (onto the current reactionless path, or into the reactionless reachable set).
 
         ``final`` is False while the operator still holds the handle (it is then never moved under them).
         """
@@ -149,7 +162,7 @@ class Operator:
             self.motion.go_to(goal)
             self.target = self._point(table.ee_at(goal))
             self.mode = "moving along the path to the target"
-            return False
+            return bool(np.linalg.norm(self.target[:2] - point[:2]) > SNAP_TOLERANCE_M)
         clamped, moved = (point[:2].copy(), False) if self.reach is None else self.reach.clamp(point)
         self.rr.set_goal(clamped)
         self.target = self._point(clamped)

@@ -20,7 +20,7 @@ from rns_viz.live import commands as c
 from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
 from rns_viz.live.guard import GUARD_EVERY, Bounds
 from rns_viz.live.kicks import kick_pulse
-from rns_viz.live.operator import InputRefused, Operator
+from rns_viz.live.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
 from rns_viz.live.readouts import arm_reach
@@ -114,6 +114,7 @@ class LiveState:
         self._reach_points: np.ndarray | None = None
         self._current_path: np.ndarray | None = None
         self._shown_level: np.ndarray | None = None
+        self._waiting_for_path: c.Command | None = None
         self.outputs.restart(self.model, self.runs.sim.q)
 
     def _go_live(self) -> Operator:
@@ -173,9 +174,16 @@ class LiveState:
 
     # ================================================================ commands
     def apply(self, cmd: c.Command) -> None:
-        """Apply one command; InputRefused/ValueError leave everything as it was and tell the sender."""
+        """Apply one command; InputRefused/ValueError leave everything as it was and tell the sender.
+
+        A path motion asked for while the current path is still being computed waits for it (the
+        latest such input wins) and runs when the path arrives.
+        """
         try:
             self._apply(cmd)
+        except PathNotReady:
+            self._waiting_for_path = cmd
+            self.notify("Waiting for the path", "It starts as soon as the reactionless path is computed.", cmd.client)
         except ValueError as exc:  # InputRefused included
             self.notify("Input not applied", str(exc), cmd.client, "warning")
             self.settings_version += 1  # the GUI shows the values actually in force
@@ -261,10 +269,14 @@ class LiveState:
             self.target_version += 1
             if moved:
                 x, y = op.target[:2]  # type: ignore[index]
+                where = (
+                    "The arm moves without reaction only along its current reactionless path"
+                    if op.on_path
+                    else "That target is outside the set reachable without reaction from this configuration"
+                )
                 self.notify(
-                    "Target clamped",
-                    f"That target is outside the set reachable without reaction from this configuration; "
-                    f"the arm goes to the nearest reachable point ({x:.2f}, {y:.2f}) m instead.",
+                    "Target moved",
+                    f"{where}; it goes to the nearest point ({x:.2f}, {y:.2f}) m instead.",
                     client,
                     "warning",
                 )
@@ -334,7 +346,7 @@ class LiveState:
 
     # ================================================================ background results
     def collect(self) -> None:
-        for ready in self.background.results(self.epoch):
+        for ready in self.background.results(lambda: self.epoch):
             match ready:
                 case JobFailed(kind=kind, error=error):
                     self.notify("Background computation failed", f"{kind}: {error}", None, "warning")
@@ -351,6 +363,9 @@ class LiveState:
                         continue
                     self._current_path = table.ee
                     self._overlays_changed()
+                    waiting, self._waiting_for_path = self._waiting_for_path, None
+                    if waiting is not None:
+                        self.apply(waiting)
                 case ReachReady(region=region):
                     if self.operator is not None and not self.operator.on_path:
                         self.operator.reach = region
