@@ -213,6 +213,26 @@ class LoadPreset(Command):
             raise ValueError(f"unknown preset {self.name!r}; choose one of {', '.join(SCENARIOS)}")
 
 
+@dataclass(frozen=True)
+class StartLesson(Command):
+    model: str  # whose lessons
+    number: int  # 1-based
+
+    def __post_init__(self) -> None:
+        from rns_viz.live.lessons import LESSONS  # the lessons are made of commands
+
+        lessons = LESSONS.get(self.model)
+        if lessons is None:
+            raise ValueError(f"no lessons for model {self.model!r}; there are some for {', '.join(LESSONS)}")
+        if isinstance(self.number, bool) or not isinstance(self.number, int) or not 1 <= self.number <= len(lessons):
+            raise ValueError(f"{self.model} has lessons 1 to {len(lessons)}, not {self.number!r}")
+
+
+@dataclass(frozen=True)
+class StopLesson(Command):
+    pass
+
+
 # Operator inputs whose arrival-to-first-step latency is measured.
 TIMED = (
     Kick,

@@ -54,6 +54,21 @@ class Readouts:
 
 
 @dataclass(frozen=True)
+class LessonStatus:
+    """The lesson in progress, for the lesson panel."""
+
+    model: str
+    number: int  # 1-based
+    count: int  # lessons of this model
+    title: str
+    equation: str
+    text: str
+    task: str
+    done: bool
+    progress: str  # what is measured now
+
+
+@dataclass(frozen=True)
 class Snapshot:
     """The loop's state for renderers; a new object each time (never mutated)."""
 
@@ -75,6 +90,7 @@ class Snapshot:
     sigma_range: tuple[float, float] | None
     readouts: Readouts = field(default_factory=Readouts)
     overlay_version: int = 0
+    lesson: LessonStatus | None = None
 
 
 @dataclass(frozen=True)

@@ -180,6 +180,13 @@ class Session:
     def load_preset(self, name: str, client: int | None = None) -> None:
         self.send(c.LoadPreset(name, client=client))
 
+    def start_lesson(self, model: str, number: int, client: int | None = None) -> None:
+        """Lesson ``number`` (1-based) of ``model``: loads its state; the snapshot reports its progress."""
+        self.send(c.StartLesson(model, number, client=client))
+
+    def stop_lesson(self, client: int | None = None) -> None:
+        self.send(c.StopLesson(client=client))
+
     # ================================================================ manual driving (realtime=False)
     def advance(self, seconds: float) -> None:
         """Apply queued commands and run ``seconds`` of simulation now, as fast as possible."""

@@ -8,7 +8,6 @@ outputs. The loop calls :meth:`LiveState.apply` for each queued command (a ``mat
 
 from __future__ import annotations
 
-import math
 from collections import deque
 from dataclasses import replace
 
@@ -20,12 +19,14 @@ from rns_viz.live import commands as c
 from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
 from rns_viz.live.guard import GUARD_EVERY, Bounds
 from rns_viz.live.kicks import kick_pulse
+from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun
 from rns_viz.live.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
 from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Level, Notice, Overlays, Settings, Snapshot
 from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
+from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.scenarios import SCENARIOS
@@ -53,6 +54,9 @@ class LiveState:
         self.diverged: str | None = None
         self.settings = default_settings(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
+        self.lesson: LessonRun | None = None
+        self.kicks_sent = 0  # kicks since the session started (lessons count them)
+        self.targets_moved = 0  # dragged targets moved onto the path / into the set (lessons count them)
         self.start_live(model)
 
     # ================================================================ set-up
@@ -215,6 +219,7 @@ class LiveState:
             case c.Kick(peak=peak):
                 duration = defaults_for(st.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m))
+                self.kicks_sent += 1
             case c.SetSuppression(on=on):
                 self.runs.set_suppression(on)
                 self.settings = replace(st, suppress=on)
@@ -256,6 +261,13 @@ class LiveState:
             case c.SwitchModel(model=name):
                 self.settings = default_settings(name, st.shadow, st.speed)
                 self.start_live(name)
+            case c.StartLesson(model=model, number=number):
+                lesson = LessonRun(model, number)
+                for step in lesson.lesson.setup:
+                    self._apply(step)
+                self.lesson = lesson
+            case c.StopLesson():
+                self.lesson = None
             case c.LoadPreset(name=name):
                 self.background.preset(self.epoch, name)
                 self.notify("Loading preset", f"{name}: {SCENARIOS[name].description}", cmd.client, "info")
@@ -266,6 +278,7 @@ class LiveState:
         op = self._go_live()
         moved = op.drag(xy, final)
         if final:
+            self.targets_moved += int(moved)
             self.target_version += 1
             if moved:
                 x, y = op.target[:2]  # type: ignore[index]
@@ -309,6 +322,8 @@ class LiveState:
             return False
         if k % SETTLE_EVERY == 0:
             self._check_settled()
+        if self.lesson is not None and k % OBSERVE_EVERY == 0:
+            self.lesson.observe(self)
         return True
 
     def _out_of_bounds(self) -> bool:
@@ -379,30 +394,4 @@ class LiveState:
         self.overlays = Overlays(family, self._current_path, self._reach_points, self.overlay_version)
 
     def publish(self, realtime: bool) -> Snapshot:
-        sim, op, out = self.runs.sim, self.operator, self.outputs
-        table = op.table if op is not None and op.on_path else None
-        mode, target = (op.mode, op.target) if op is not None else (f"preset {self.settings.preset}", None)
-        readouts = replace(out.readouts, reaction=out.reaction)
-        shadow_on = self.settings.shadow
-        return Snapshot(
-            epoch=self.epoch,
-            settings=self.settings,
-            settings_version=self.settings_version,
-            steps=out.steps,
-            t=sim.t,
-            q=sim.q.copy(),
-            q_shadow=self.runs.shadow.q.copy() if shadow_on else None,
-            paused=self.paused,
-            diverged=self.diverged,
-            rtf=0.0 if self.paused else self.pacer.rtf() if realtime else math.nan,
-            behind=realtime and not self.paused and self.pacer.behind(),
-            mode="paused" if self.paused and not self.diverged else mode,
-            target=None if target is None else target.copy(),
-            target_version=self.target_version,
-            sigma=op.sigma if op is not None else None,
-            sigma_range=None
-            if table is None
-            else ((-0.5 * table.period, 0.5 * table.period) if table.closed else (table.lo, table.hi)),
-            readouts=readouts,
-            overlay_version=self.overlay_version,
-        )
+        return make_snapshot(self, realtime)

@@ -1,0 +1,362 @@
+"""Lessons: short guided steps through the paper, each with a task whose completion is measured.
+
+A :class:`Lesson` says what it is about (a sentence or two and the paper's equation), loads a state
+(commands the loop applies: model, law, suppression, shadow), gives the student a task and checks it
+from the simulation: a :class:`Check` observes the run every few steps and says when the task is
+done. Checks start afresh when the run restarts (reset, model switch). Nothing here imports viser.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from rns_viz.live import commands as c
+from rns_viz.model import FsmsModel
+
+
+@dataclass(frozen=True)
+class RunView:
+    """What a check may look at after a step (SI units; x_b the base deflection along S's first row)."""
+
+    epoch: int
+    t: float  # s
+    x_b: float  # m, operated run
+    x_b_shadow: float  # m, the shadow run (nan without it)
+    theta: np.ndarray  # rad
+    ee: np.ndarray  # (x, y) m, base frame
+    mode: str  # what the operator's reference is doing
+    kicks: int  # kicks since the lesson started
+    sigma_hbm: float  # kg m, smallest singular value of S H_bm
+    ee_target: np.ndarray | None  # (x, y) m, where the arm is sent; None without one
+    targets_moved: int  # dragged targets moved onto the path / into the reachable set so far
+
+
+@dataclass(frozen=True)
+class Progress:
+    done: bool
+    message: str  # for the student: what is measured now
+
+
+class Check:
+    """Observes runs; subclasses keep what they need and say :meth:`progress`."""
+
+    def __init__(self, model: FsmsModel) -> None:
+        self.model = model
+        H_b = float(model.mass_matrix(model.q(model.spec.default_configuration))[0, 0])
+        self.period = 2 * math.pi * math.sqrt(H_b / float(model.K_b[0, 0]))  # s, the base's swing
+        self.sigma0 = float(np.linalg.svd(model.coupling_matrix(model.q(model.spec.default_configuration)))[1][-1])
+        self._epoch: int | None = None
+        self.done = False
+
+    def observe(self, view: RunView) -> None:
+        if view.epoch != self._epoch:  # the run restarted: so does the task
+            self._epoch, self.done = view.epoch, False
+            self.restart(view)
+        if not self.done:
+            self.update(view)
+
+    def restart(self, view: RunView) -> None: ...
+
+    def update(self, view: RunView) -> None: ...
+
+    def progress(self) -> Progress:
+        raise NotImplementedError
+
+
+class Envelope:
+    """max |x| over the last ``window`` s, from samples every observation."""
+
+    def __init__(self, window: float) -> None:
+        self.window = window
+        self.samples: deque[tuple[float, float]] = deque()
+
+    def add(self, t: float, x: float) -> float:
+        self.samples.append((t, abs(x)))
+        while self.samples and self.samples[0][0] < t - self.window:
+            self.samples.popleft()
+        return max(v for _, v in self.samples)
+
+
+class KickAndSwing(Check):
+    """A kick with nothing damping it: the base swings on, undamped (Eq. 1)."""
+
+    def restart(self, view: RunView) -> None:
+        self.kicks0, self.peak, self.kick_t = view.kicks, 0.0, math.nan
+        self.env = Envelope(1.2 * self.period)
+
+    def update(self, v: RunView) -> None:
+        if v.kicks > self.kicks0 and math.isnan(self.kick_t):
+            self.kick_t = v.t
+        env = self.env.add(v.t, v.x_b)
+        if not math.isnan(self.kick_t):
+            self.peak = max(self.peak, abs(v.x_b))
+            self.done = v.t > self.kick_t + 3 * self.period and self.peak > 1e-3 and env > 0.5 * self.peak
+
+    def progress(self) -> Progress:
+        if math.isnan(self.kick_t):
+            return Progress(False, "Waiting for a kick.")
+        return Progress(self.done, f"Peak deflection {self.peak * 1e3:.2f} mm; it keeps swinging.")
+
+
+class StaysStill(Check):
+    """Reach the other side of the path (joint 2 past 150 deg) with |x_b| below 0.1 mm (Eqs. 27, 30)."""
+
+    LIMIT_M = 1e-4
+
+    def restart(self, view: RunView) -> None:
+        self.peak, self.theta2_0 = 0.0, float(view.theta[1])
+
+    def update(self, v: RunView) -> None:
+        self.peak = max(self.peak, abs(v.x_b))
+        turned = abs(float(v.theta[1]) - self.theta2_0)
+        self.turned = turned
+        self.done = turned > math.radians(150) and self.peak < self.LIMIT_M and "path" not in v.mode
+
+    def progress(self) -> Progress:
+        turned = math.degrees(getattr(self, "turned", 0.0))
+        if self.peak >= self.LIMIT_M:
+            return Progress(False, f"The base moved {self.peak * 1e3:.2f} mm: too much. Press Reset and try again.")
+        return Progress(self.done, f"Joint 2 turned {turned:.0f} deg; base deflection so far {self.peak * 1e6:.1f} µm.")
+
+
+class ShakesTheBase(Check):
+    """The joint-space motion between the same end points shakes the base (Fig. 11(b))."""
+
+    def restart(self, view: RunView) -> None:
+        self.peak, self.started = 0.0, False
+
+    def update(self, v: RunView) -> None:
+        self.peak = max(self.peak, abs(v.x_b))
+        self.started = self.started or v.mode.startswith("point-to-point")
+        self.done = self.started and not v.mode.startswith("point-to-point") and self.peak > 5e-4
+
+    def progress(self) -> Progress:
+        return Progress(self.done, f"Peak base deflection {self.peak * 1e3:.2f} mm.")
+
+
+class SuppressedVersusShadow(Check):
+    """After a kick the operated run's swing falls below 10 % while the shadow's stays above 50 %."""
+
+    def restart(self, view: RunView) -> None:
+        self.kicks0, self.peak, self.peak_shadow = view.kicks, 0.0, 0.0
+        self.env, self.env_shadow = Envelope(1.2 * self.period), Envelope(1.2 * self.period)
+        self.ratio, self.ratio_shadow = 1.0, 1.0
+
+    def update(self, v: RunView) -> None:
+        env, env_s = self.env.add(v.t, v.x_b), self.env_shadow.add(v.t, v.x_b_shadow)
+        if v.kicks <= self.kicks0 or math.isnan(v.x_b_shadow):
+            return
+        self.peak, self.peak_shadow = max(self.peak, env), max(self.peak_shadow, env_s)
+        if self.peak > 1e-4:
+            self.ratio, self.ratio_shadow = env / self.peak, env_s / max(self.peak_shadow, 1e-300)
+            self.done = self.ratio < 0.1 and self.ratio_shadow > 0.5
+
+    def progress(self) -> Progress:
+        if self.peak <= 1e-4:
+            return Progress(False, "Waiting for a kick (with the shadow run shown).")
+        return Progress(
+            self.done, f"Swing now {self.ratio:.0%} of its peak; the shadow's {self.ratio_shadow:.0%} of its own."
+        )
+
+
+class WeakestPoint(Check):
+    """Hold the arm where sigma(S H_bm) is at most 65 % of its value at the start configuration."""
+
+    def update(self, v: RunView) -> None:
+        self.ratio = v.sigma_hbm / self.sigma0
+        self.done = self.ratio <= 0.65 and "path" not in v.mode
+
+    def progress(self) -> Progress:
+        ratio = getattr(self, "ratio", 1.0)
+        return Progress(self.done, f"sigma(H_bm) here is {ratio:.0%} of its value at the start.")
+
+
+class CyclicAndKick(Check):
+    """Cyclic motion along the path goes on while a kick dies out (Fig. 12)."""
+
+    def restart(self, view: RunView) -> None:
+        self.kicks0, self.peak, self.ratio = view.kicks, 0.0, 1.0
+        self.env = Envelope(1.2 * self.period)
+
+    def update(self, v: RunView) -> None:
+        env = self.env.add(v.t, v.x_b)
+        cyclic = v.mode.startswith("cyclic")
+        if v.kicks > self.kicks0 and cyclic:
+            self.peak = max(self.peak, env)
+            self.ratio = env / max(self.peak, 1e-300)
+            self.done = self.peak > 1e-4 and self.ratio < 0.2
+
+    def progress(self) -> Progress:
+        if self.peak <= 1e-4:
+            return Progress(False, "Start cyclic motion, then kick.")
+        return Progress(self.done, f"Swing now {self.ratio:.0%} of its peak, the arm still circling.")
+
+
+class TrackWithoutReaction(Check):
+    """Move the end effector 20 cm or more with |x_b| below 0.1 mm and arrive (Eq. 24)."""
+
+    def restart(self, view: RunView) -> None:
+        self.start, self.peak, self.moved, self.error = view.ee.copy(), 0.0, 0.0, math.inf
+
+    def update(self, v: RunView) -> None:
+        self.peak = max(self.peak, abs(v.x_b))
+        self.moved = max(self.moved, float(np.linalg.norm(v.ee - self.start)))
+        self.error = math.inf if v.ee_target is None else float(np.linalg.norm(v.ee_target - v.ee))
+        self.done = self.moved >= 0.2 and self.peak < 1e-4 and self.error < 5e-3
+
+    def progress(self) -> Progress:
+        return Progress(self.done, f"Moved {self.moved * 100:.0f} cm; base deflection so far {self.peak * 1e6:.1f} µm.")
+
+
+class ClampedTarget(Check):
+    """Drag beyond the reactionless-reachable set: the target is moved in, and the arm goes as far as it
+    can without reaction (to the moved target, or to a fold curve where J-bar loses rank) and stops."""
+
+    def restart(self, view: RunView) -> None:
+        self.moved0, self.clamped, self.settled = view.targets_moved, False, False
+        self.trail: deque[tuple[float, np.ndarray]] = deque()
+
+    def update(self, v: RunView) -> None:
+        self.clamped = self.clamped or v.targets_moved > self.moved0
+        if not self.clamped:
+            return
+        self.trail.append((v.t, v.ee.copy()))
+        while self.trail[0][0] < v.t - 0.5:
+            self.trail.popleft()
+        span = self.trail[-1][0] - self.trail[0][0]
+        still = max(float(np.linalg.norm(p - v.ee)) for _, p in self.trail) < 5e-4
+        self.done = span >= 0.45 and still
+
+    def progress(self) -> Progress:
+        if not self.clamped:
+            return Progress(False, "Drag the target far out of the shaded region.")
+        return Progress(self.done, "The target was moved into the set; the arm went as far as it can.")
+
+
+class AbsorbKick(Check):
+    """A kick of 2 N or more, damped to 10 % of its peak by law (15)."""
+
+    def restart(self, view: RunView) -> None:
+        self.kicks0, self.peak, self.ratio = view.kicks, 0.0, 1.0
+        self.env = Envelope(1.2 * self.period)
+
+    def update(self, v: RunView) -> None:
+        env = self.env.add(v.t, v.x_b)
+        if v.kicks > self.kicks0:
+            self.peak = max(self.peak, env)
+            self.ratio = env / max(self.peak, 1e-300)
+            self.done = self.peak > 2e-3 and self.ratio < 0.1
+
+    def progress(self) -> Progress:
+        if self.peak <= 2e-3:
+            return Progress(False, "Kick harder (the deflection should pass 2 mm).")
+        return Progress(self.done, f"Swing now {self.ratio:.0%} of its peak.")
+
+
+@dataclass(frozen=True)
+class Lesson:
+    title: str
+    equation: str  # the paper's equation(s) it is about
+    text: str  # one or two sentences of explanation
+    task: str  # what the student does
+    setup: tuple[c.Command, ...]  # applied in order when the lesson starts
+    check: Callable[[FsmsModel], Check]
+
+
+def _start(model: str, law: str, suppress: bool) -> tuple[c.Command, ...]:
+    return (c.SwitchModel(model), c.SetLaw(law), c.SetSuppression(suppress), c.SetShadow(True))  # type: ignore[arg-type]
+
+
+TREP_LESSONS = (
+    Lesson(
+        "The base is a spring",
+        "Eq. (1)",
+        "TREP's arm sits on the tip of a flexible beam: the base moves as a mass on a spring, pushed by outside "
+        "forces and by the arm's own motion. With the joints held, nothing damps it.",
+        "Kick the base (Kick button) and watch it swing.",
+        _start("trep", "velocity", False),
+        KickAndSwing,
+    ),
+    Lesson(
+        "A motion that pushes",
+        "Eq. (8): L = H_bm θ'",
+        "Every joint motion carries coupling momentum L = H_bm θ' into the base, unless it is reactionless.",
+        "Press 'Point to point': joint 2 turns alone by half a turn. Watch the base.",
+        _start("trep", "velocity", True),
+        ShakesTheBase,
+    ),
+    Lesson(
+        "The reactionless path",
+        "Eqs. (27), (30): θ' = n ū",
+        "Moving along n, the null-space vector of H_bm, keeps L = 0: the base feels nothing. ū (1/(kg m s)) "
+        "sets the speed along the path.",
+        "Move along the path (Play slowly, or drag the handle) so the arm reaches the other side with the "
+        "base deflection below 0.1 mm.",
+        _start("trep", "velocity", True),
+        StaysStill,
+    ),
+    Lesson(
+        "Vibration suppression",
+        "Eq. (30): θ'_cmd = H_bm⁺ m_b g_b x_b + g_m (θ_ref − θ)",
+        "The arm damps the base by a motion outside the reaction null space, proportional to the deflection. "
+        "The shadow run gets the same kick with suppression off.",
+        "Kick the base and compare the arm with its shadow.",
+        _start("trep", "velocity", True),
+        SuppressedVersusShadow,
+    ),
+    Lesson(
+        "Where suppression is weakest",
+        "Eq. (30): H_bm⁺",
+        "The smaller σ(H_bm), the faster the joints must turn for the same push on the base; where H_bm "
+        "vanishes the arm has no authority over the base at all.",
+        "Move along the path to where σ(H_bm) (readout) is at most 65 % of its start value, and stop there.",
+        _start("trep", "velocity", True),
+        WeakestPoint,
+    ),
+    Lesson(
+        "Moving and suppressing at once",
+        "Fig. 12",
+        "Reactionless motion and vibration suppression add up: the first never reaches the base, the "
+        "second acts only on it.",
+        "Start cyclic motion along the path, then kick the base.",
+        _start("trep", "velocity", True),
+        CyclicAndKick,
+    ),
+)
+
+PLANAR3R_LESSONS = (
+    Lesson(
+        "Reactionless end-point tracking",
+        "Eq. (24)",
+        "Three joints, one base direction: a two-dimensional reaction null space, enough to move the end "
+        "effector in the plane without pushing the base.",
+        "Drag the target 20 cm or more; the base must stay below 0.1 mm.",
+        _start("planar3r", "acceleration", True),
+        TrackWithoutReaction,
+    ),
+    Lesson(
+        "The reactionless-reachable set",
+        "Sec. V",
+        "Without reaction the arm's centre of mass cannot move along the base direction, so only part of "
+        "the workspace is reachable: the shaded region. Its fold curves are where J-bar loses rank.",
+        "Drag the target far outside the shaded region and watch where the arm goes and where it stops.",
+        _start("planar3r", "acceleration", True),
+        ClampedTarget,
+    ),
+    Lesson(
+        "Absorbing a kick",
+        "Eq. (15)",
+        "Law (15) damps the base by moving the arm's centre of mass; the end effector keeps its target, so "
+        "the arm swings its elbow to do it.",
+        "Kick the base with 2 N or more and watch the arm absorb it.",
+        _start("planar3r", "acceleration", True),
+        AbsorbKick,
+    ),
+)
+
+LESSONS: dict[str, tuple[Lesson, ...]] = {"trep": TREP_LESSONS, "planar3r": PLANAR3R_LESSONS}
