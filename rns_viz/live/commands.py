@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from rns_viz.control import Gains, InvalidGain, LawKind
+from rns_viz.live.lessons import LESSONS
 from rns_viz.live.pacing import SPEEDS
 from rns_viz.params import MODEL_NAMES
 from rns_viz.scenarios import SCENARIOS
@@ -219,8 +220,6 @@ class StartLesson(Command):
     number: int  # 1-based
 
     def __post_init__(self) -> None:
-        from rns_viz.live.lessons import LESSONS  # the lessons are made of commands
-
         lessons = LESSONS.get(self.model)
         if lessons is None:
             raise ValueError(f"no lessons for model {self.model!r}; there are some for {', '.join(LESSONS)}")

@@ -3,15 +3,12 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
-
-import numpy as np
 
 from rns_viz.live.lessons import LESSONS, Check, Lesson, RunView
+from rns_viz.live.operator import Operator
 from rns_viz.live.records import LessonStatus
-
-if TYPE_CHECKING:
-    from rns_viz.live.state import LiveState
+from rns_viz.live.runs import RunPair
+from rns_viz.model import FsmsModel
 
 OBSERVE_EVERY = 10  # steps between observations (10 ms)
 
@@ -22,29 +19,10 @@ class LessonRun:
         self.lesson: Lesson = LESSONS[model][number - 1]
         self.check: Check | None = None  # made on the first observation, with the loop's model
 
-    def observe(self, state: LiveState) -> None:
-        runs, op = state.runs, state.operator
-        model = state.model
+    def observe(self, model: FsmsModel, view: RunView) -> None:
         if self.check is None:
-            self.check = self.lesson.check(model)
-        m = model.m
-        theta = runs.sim.q[m:].copy()
-        target = op.target[:2].copy() if op is not None and op.target is not None else None
-        self.check.observe(
-            RunView(
-                epoch=state.epoch,
-                t=runs.t,
-                x_b=float(runs.sim.q[model.selected[0]]),
-                x_b_shadow=float(runs.shadow.q[model.selected[0]]) if state.settings.shadow else math.nan,
-                theta=theta,
-                ee=model.ee_position(theta)[:2],
-                mode=op.mode if op is not None else "preset",
-                kicks=state.kicks_sent,
-                sigma_hbm=state.outputs.readouts.sigma_hbm,
-                ee_target=None if target is None else np.asarray(target),
-                targets_moved=state.targets_moved,
-            )
-        )
+            self.check = self.lesson.check(model)  # with the loop's own model instance
+        self.check.observe(view)
 
     def status(self) -> LessonStatus:
         progress = self.check.progress() if self.check is not None else None
@@ -60,3 +38,31 @@ class LessonRun:
             done=progress.done if progress is not None else False,
             progress=progress.message if progress is not None else "",
         )
+
+
+def run_view(
+    model: FsmsModel,
+    epoch: int,
+    runs: RunPair,
+    op: Operator | None,
+    shadow: bool,
+    counts: tuple[int, int],
+    sigma: float,
+) -> RunView:
+    """What a lesson's check sees now; ``counts`` = (kicks, dragged targets moved) so far, ``sigma`` of S H_bm."""
+    theta = runs.sim.q[model.m :].copy()
+    row = int(model.selected[0])
+    target = op.target[:2].copy() if op is not None and op.target is not None else None
+    return RunView(
+        epoch=epoch,
+        t=runs.t,
+        x_b=float(runs.sim.q[row]),
+        x_b_shadow=float(runs.shadow.q[row]) if shadow else math.nan,
+        theta=theta,
+        ee=model.ee_position(theta)[:2],
+        mode=op.mode if op is not None else "preset",
+        kicks=counts[0],
+        sigma_hbm=sigma,
+        ee_target=target,
+        targets_moved=counts[1],
+    )

@@ -1,7 +1,7 @@
 """Lessons: short guided steps through the paper, each with a task whose completion is measured.
 
 A :class:`Lesson` says what it is about (a sentence or two and the paper's equation), loads a state
-(commands the loop applies: model, law, suppression, shadow), gives the student a task and checks it
+(model, law, suppression; the shadow run shown), gives the student a task and checks it
 from the simulation: a :class:`Check` observes the run every few steps and says when the task is
 done. Checks start afresh when the run restarts (reset, model switch). Nothing here imports viser.
 """
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.live import commands as c
+from rns_viz.control import LawKind
 from rns_viz.model import FsmsModel
 
 
@@ -259,17 +259,22 @@ class AbsorbKick(Check):
 
 
 @dataclass(frozen=True)
+class LessonStart:
+    """The state a lesson loads: a fresh run of ``model`` at rest, the law, suppression, shadow shown."""
+
+    model: str
+    law: LawKind
+    suppress: bool
+
+
+@dataclass(frozen=True)
 class Lesson:
     title: str
     equation: str  # the paper's equation(s) it is about
     text: str  # one or two sentences of explanation
     task: str  # what the student does
-    setup: tuple[c.Command, ...]  # applied in order when the lesson starts
+    start: LessonStart
     check: Callable[[FsmsModel], Check]
-
-
-def _start(model: str, law: str, suppress: bool) -> tuple[c.Command, ...]:
-    return (c.SwitchModel(model), c.SetLaw(law), c.SetSuppression(suppress), c.SetShadow(True))  # type: ignore[arg-type]
 
 
 TREP_LESSONS = (
@@ -279,7 +284,7 @@ TREP_LESSONS = (
         "TREP's arm sits on the tip of a flexible beam: the base moves as a mass on a spring, pushed by outside "
         "forces and by the arm's own motion. With the joints held, nothing damps it.",
         "Kick the base (Kick button) and watch it swing.",
-        _start("trep", "velocity", False),
+        LessonStart("trep", "velocity", False),
         KickAndSwing,
     ),
     Lesson(
@@ -287,7 +292,7 @@ TREP_LESSONS = (
         "Eq. (8): L = H_bm θ'",
         "Every joint motion carries coupling momentum L = H_bm θ' into the base, unless it is reactionless.",
         "Press 'Point to point': joint 2 turns alone by half a turn. Watch the base.",
-        _start("trep", "velocity", True),
+        LessonStart("trep", "velocity", True),
         ShakesTheBase,
     ),
     Lesson(
@@ -297,7 +302,7 @@ TREP_LESSONS = (
         "sets the speed along the path.",
         "Move along the path (Play slowly, or drag the handle) so the arm reaches the other side with the "
         "base deflection below 0.1 mm.",
-        _start("trep", "velocity", True),
+        LessonStart("trep", "velocity", True),
         StaysStill,
     ),
     Lesson(
@@ -306,7 +311,7 @@ TREP_LESSONS = (
         "The arm damps the base by a motion outside the reaction null space, proportional to the deflection. "
         "The shadow run gets the same kick with suppression off.",
         "Kick the base and compare the arm with its shadow.",
-        _start("trep", "velocity", True),
+        LessonStart("trep", "velocity", True),
         SuppressedVersusShadow,
     ),
     Lesson(
@@ -315,7 +320,7 @@ TREP_LESSONS = (
         "The smaller σ(H_bm), the faster the joints must turn for the same push on the base; where H_bm "
         "vanishes the arm has no authority over the base at all.",
         "Move along the path to where σ(H_bm) (readout) is at most 65 % of its start value, and stop there.",
-        _start("trep", "velocity", True),
+        LessonStart("trep", "velocity", True),
         WeakestPoint,
     ),
     Lesson(
@@ -324,7 +329,7 @@ TREP_LESSONS = (
         "Reactionless motion and vibration suppression add up: the first never reaches the base, the "
         "second acts only on it.",
         "Start cyclic motion along the path, then kick the base.",
-        _start("trep", "velocity", True),
+        LessonStart("trep", "velocity", True),
         CyclicAndKick,
     ),
 )
@@ -336,7 +341,7 @@ PLANAR3R_LESSONS = (
         "Three joints, one base direction: a two-dimensional reaction null space, enough to move the end "
         "effector in the plane without pushing the base.",
         "Drag the target 20 cm or more; the base must stay below 0.1 mm.",
-        _start("planar3r", "acceleration", True),
+        LessonStart("planar3r", "acceleration", True),
         TrackWithoutReaction,
     ),
     Lesson(
@@ -345,7 +350,7 @@ PLANAR3R_LESSONS = (
         "Without reaction the arm's centre of mass cannot move along the base direction, so only part of "
         "the workspace is reachable: the shaded region. Its fold curves are where J-bar loses rank.",
         "Drag the target far outside the shaded region and watch where the arm goes and where it stops.",
-        _start("planar3r", "acceleration", True),
+        LessonStart("planar3r", "acceleration", True),
         ClampedTarget,
     ),
     Lesson(
@@ -354,7 +359,7 @@ PLANAR3R_LESSONS = (
         "Law (15) damps the base by moving the arm's centre of mass; the end effector keeps its target, so "
         "the arm swings its elbow to do it.",
         "Kick the base with 2 N or more and watch the arm absorb it.",
-        _start("planar3r", "acceleration", True),
+        LessonStart("planar3r", "acceleration", True),
         AbsorbKick,
     ),
 )

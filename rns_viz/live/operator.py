@@ -169,6 +169,15 @@ class Operator:
         self.mode = "tracking the target"
         return moved
 
+    def why_moved(self) -> str:
+        """What to tell the operator when :meth:`drag` moved their target."""
+        x, y = self.target[:2]  # type: ignore[index]
+        if self.on_path:
+            where = "The arm moves without reaction only along its current reactionless path"
+        else:
+            where = "That target is outside the set reachable without reaction from this configuration"
+        return f"{where}; it goes to the nearest point ({x:.2f}, {y:.2f}) m instead."
+
     def scrub(self, sigma: float) -> None:
         """Move along the path to the slider's sigma (centred for closed paths), rate-limited by u-bar."""
         table = self._need_table()

@@ -2,43 +2,52 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
-from rns_viz.live.records import Snapshot
+from rns_viz.live.operator import Operator
+from rns_viz.live.outputs import Outputs
+from rns_viz.live.records import LessonStatus, Settings, Snapshot
+from rns_viz.live.runs import RunPair
 
-if TYPE_CHECKING:
-    from rns_viz.live.state import LiveState
 
-
-def make_snapshot(state: LiveState, realtime: bool) -> Snapshot:
-    """The loop's state for readers: a new immutable record each time."""
-    sim, op, out = state.runs.sim, state.operator, state.outputs
+def make_snapshot(
+    settings: Settings,
+    versions: tuple[int, int, int, int],
+    runs: RunPair,
+    op: Operator | None,
+    out: Outputs,
+    flags: tuple[bool, str | None, float, bool],
+    lesson: LessonStatus | None,
+) -> Snapshot:
+    """The loop's state for readers, a new immutable record each time. ``versions`` = (epoch, settings,
+    target, overlay) versions; ``flags`` = (paused, why it diverged or None, real-time factor, behind)."""
+    sim = runs.sim
+    epoch, settings_version, target_version, overlay_version = versions
+    paused, diverged, rtf, behind = flags
     table = op.table if op is not None and op.on_path else None
-    mode, target = (op.mode, op.target) if op is not None else (f"preset {state.settings.preset}", None)
+    mode, target = (op.mode, op.target) if op is not None else (f"preset {settings.preset}", None)
     readouts = replace(out.readouts, reaction=out.reaction)
-    shadow_on = state.settings.shadow
+    shadow_on = settings.shadow
     return Snapshot(
-        epoch=state.epoch,
-        settings=state.settings,
-        settings_version=state.settings_version,
+        epoch=epoch,
+        settings=settings,
+        settings_version=settings_version,
         steps=out.steps,
         t=sim.t,
         q=sim.q.copy(),
-        q_shadow=state.runs.shadow.q.copy() if shadow_on else None,
-        paused=state.paused,
-        diverged=state.diverged,
-        rtf=0.0 if state.paused else state.pacer.rtf() if realtime else math.nan,
-        behind=realtime and not state.paused and state.pacer.behind(),
-        mode="paused" if state.paused and not state.diverged else mode,
+        q_shadow=runs.shadow.q.copy() if shadow_on else None,
+        paused=paused,
+        diverged=diverged,
+        rtf=rtf,
+        behind=behind,
+        mode="paused" if paused and not diverged else mode,
         target=None if target is None else target.copy(),
-        target_version=state.target_version,
+        target_version=target_version,
         sigma=op.sigma if op is not None else None,
         sigma_range=None
         if table is None
         else ((-0.5 * table.period, 0.5 * table.period) if table.closed else (table.lo, table.hi)),
         readouts=readouts,
-        overlay_version=state.overlay_version,
-        lesson=state.lesson.status() if state.lesson is not None else None,
+        overlay_version=overlay_version,
+        lesson=lesson,
     )

@@ -8,6 +8,7 @@ outputs. The loop calls :meth:`LiveState.apply` for each queued command (a ``mat
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import replace
 
@@ -19,7 +20,7 @@ from rns_viz.live import commands as c
 from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
 from rns_viz.live.guard import GUARD_EVERY, Bounds
 from rns_viz.live.kicks import kick_pulse
-from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun
+from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun, run_view
 from rns_viz.live.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
@@ -263,8 +264,10 @@ class LiveState:
                 self.start_live(name)
             case c.StartLesson(model=model, number=number):
                 lesson = LessonRun(model, number)
-                for step in lesson.lesson.setup:
+                start = lesson.lesson.start
+                for step in (c.SwitchModel(start.model), c.SetLaw(start.law), c.SetSuppression(start.suppress)):
                     self._apply(step)
+                self._apply(c.SetShadow(True))
                 self.lesson = lesson
             case c.StopLesson():
                 self.lesson = None
@@ -281,18 +284,7 @@ class LiveState:
             self.targets_moved += int(moved)
             self.target_version += 1
             if moved:
-                x, y = op.target[:2]  # type: ignore[index]
-                where = (
-                    "The arm moves without reaction only along its current reactionless path"
-                    if op.on_path
-                    else "That target is outside the set reachable without reaction from this configuration"
-                )
-                self.notify(
-                    "Target moved",
-                    f"{where}; it goes to the nearest point ({x:.2f}, {y:.2f}) m instead.",
-                    client,
-                    "warning",
-                )
+                self.notify("Target moved", op.why_moved(), client, "warning")
 
     # ================================================================ steps
     def tick(self) -> bool:
@@ -323,7 +315,9 @@ class LiveState:
         if k % SETTLE_EVERY == 0:
             self._check_settled()
         if self.lesson is not None and k % OBSERVE_EVERY == 0:
-            self.lesson.observe(self)
+            counts, sigma = (self.kicks_sent, self.targets_moved), self.outputs.readouts.sigma_hbm
+            view = run_view(self.model, self.epoch, runs, op, self.settings.shadow, counts, sigma)
+            self.lesson.observe(self.model, view)
         return True
 
     def _out_of_bounds(self) -> bool:
@@ -394,4 +388,8 @@ class LiveState:
         self.overlays = Overlays(family, self._current_path, self._reach_points, self.overlay_version)
 
     def publish(self, realtime: bool) -> Snapshot:
-        return make_snapshot(self, realtime)
+        versions = (self.epoch, self.settings_version, self.target_version, self.overlay_version)
+        lesson = self.lesson.status() if self.lesson is not None else None
+        rtf = 0.0 if self.paused else self.pacer.rtf() if realtime else math.nan
+        flags = (self.paused, self.diverged, rtf, realtime and not self.paused and self.pacer.behind())
+        return make_snapshot(self.settings, versions, self.runs, self.operator, self.outputs, flags, lesson)
