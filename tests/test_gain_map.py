@@ -221,3 +221,18 @@ def test_authority_fades_only_where_the_damped_inverse_engages(trep: FsmsModel) 
     assert np.ptp(rates.base_decay_rate[far]) < 1e-3 * rates.base_decay_rate[0]
     assert np.all(np.diff(rates.base_decay_rate[~far]) < 0)
     assert rates.base_decay_rate[-1] < 0.2 * rates.base_decay_rate[0]
+
+
+def test_fig12_preset_decays_as_the_map_predicts_along_its_path(trep: FsmsModel) -> None:
+    """Fig. 12's gain: on the cyclic reactionless path the map predicts one base decay everywhere,
+    and the preset's kick decays at it, as Fig. 10(a) does at the same gains (0.40 /s)."""
+    from rns_viz.paths import trace_paths
+    from rns_viz.scenarios import FIG12_GAINS, FIG12_KICK_AT_S, run_scenario
+
+    path = trace_paths(trep, np.deg2rad([[90.0, 0.0]]), ds=0.2)[0]
+    along = authority(loops_along(trep, "velocity", path.theta), FIG12_GAINS.g_b, FIG12_GAINS.g_m)
+    assert np.ptp(along.base_decay_rate) < 1e-3 * along.base_decay_rate.mean()
+    log = run_scenario("fig12-on").log
+    fit = fit_decay(log.column("t"), log.column("xb_1"), start=FIG12_KICK_AT_S + 0.2)
+    assert fit.rate == pytest.approx(along.base_decay_rate.mean(), rel=0.05)
+    assert fit.rate == pytest.approx(0.40, abs=0.02)
