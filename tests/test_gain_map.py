@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import contextlib
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +25,8 @@ from rns_viz.analysis import (
 from rns_viz.control import AccelerationLaw, FixedReference, Gains, TorqueLaw, VelocityLaw
 from rns_viz.control.common import CouplingEvaluator
 from rns_viz.model import FsmsModel
+from rns_viz.paths import trace_paths
+from rns_viz.scenarios import FIG12_GAINS, FIG12_KICK_AT_S, run_scenario
 from rns_viz.sim import ForcePulse, SimulationDiverged, Simulator
 
 RNG = np.random.default_rng(10)
@@ -226,9 +231,6 @@ def test_authority_fades_only_where_the_damped_inverse_engages(trep: FsmsModel) 
 def test_fig12_preset_decays_as_the_map_predicts_along_its_path(trep: FsmsModel) -> None:
     """Fig. 12's gain: on the cyclic reactionless path the map predicts one base decay everywhere,
     and the preset's kick decays at it, as Fig. 10(a) does at the same gains (0.40 /s)."""
-    from rns_viz.paths import trace_paths
-    from rns_viz.scenarios import FIG12_GAINS, FIG12_KICK_AT_S, run_scenario
-
     path = trace_paths(trep, np.deg2rad([[90.0, 0.0]]), ds=0.2)[0]
     along = authority(loops_along(trep, "velocity", path.theta), FIG12_GAINS.g_b, FIG12_GAINS.g_m)
     assert np.ptp(along.base_decay_rate) < 1e-3 * along.base_decay_rate.mean()
@@ -236,3 +238,52 @@ def test_fig12_preset_decays_as_the_map_predicts_along_its_path(trep: FsmsModel)
     fit = fit_decay(log.column("t"), log.column("xb_1"), start=FIG12_KICK_AT_S + 0.2)
     assert fit.rate == pytest.approx(along.base_decay_rate.mean(), rel=0.05)
     assert fit.rate == pytest.approx(0.40, abs=0.02)
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "rns_viz.cli", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_cli_gains_writes_the_map(tmp_path: Path) -> None:
+    out = tmp_path / "map.csv"
+    result = _cli("gains", "--model", "trep", "--law", "30", "--csv", str(out))
+    assert result.returncode == 0, result.stderr
+    header = out.read_text().splitlines()[0].split(",")
+    assert header[:6] == ["g_b", "g_m", "base_decay_rate_per_s", "arm_decay_rate_per_s", "base_damping_ratio", "stable"]
+    data = np.genfromtxt(out, delimiter=",", skip_header=1)
+    assert data.shape == (3600, len(header))
+    stable = data[:, 5].astype(bool)
+    assert stable.any() and not stable.all()
+    assert np.all(data[stable, 2] > 0)
+    # the same numbers as the library
+    paper = np.argmin(np.abs(np.log(data[:, 0] / 24.0)) + np.abs(np.log(data[:, 1] / 20.0)))
+    loop = linearise(FsmsModel.from_name("trep"), "velocity")
+    expected = float(modes_of(loop, data[paper, 0], data[paper, 1]).base_decay_rate)
+    assert data[paper, 2] == pytest.approx(expected, rel=1e-5)
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--law", "17"], "unknown law '17'"),
+        (["--theta-deg", "1", "2", "3"], "needs 2 joint angles"),
+        (["--model", "nosuch"], "invalid choice"),
+        (["--size", "0"], "must be at least 1"),
+    ],
+)
+def test_cli_gains_bad_arguments_give_one_line(args: list[str], fragment: str, tmp_path: Path) -> None:
+    result = _cli("gains", "--csv", str(tmp_path / "x.csv"), *args)
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr and fragment in result.stderr
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_gain_map_figure_is_drawn(tmp_path: Path) -> None:
+    from PIL import Image
+
+    from rns_viz.figures import draw_all
+
+    (path,) = draw_all(tmp_path, ["gain_map_trep"])
+    assert path.name == "gain_map_trep.png"
+    image = np.asarray(Image.open(path).convert("L"))
+    assert min(image.shape) >= 350 and image.std() > 10
