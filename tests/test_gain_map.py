@@ -287,3 +287,14 @@ def test_gain_map_figure_is_drawn(tmp_path: Path) -> None:
     assert path.name == "gain_map_trep.png"
     image = np.asarray(Image.open(path).convert("L"))
     assert min(image.shape) >= 350 and image.std() > 10
+
+
+def test_a_state_that_is_not_at_rest_is_refused(tmp_path: Path) -> None:
+    """Gravity along the base axis loads the spring: x_b = 0 is no equilibrium to linearise about."""
+    assets = Path(__file__).resolve().parent.parent / "assets"
+    text = (assets / "trep.toml").read_text()
+    text = text.replace("gravity_m_per_s2 = [0.0, 0.0, 0.0]", "gravity_m_per_s2 = [-9.81, 0.0, 0.0]")
+    text = text.replace('urdf = "trep.urdf"', f'urdf = "{(assets / "trep.urdf").as_posix()}"')
+    (tmp_path / "tilted.toml").write_text(text)
+    with pytest.raises(ValueError, match="not an equilibrium"):
+        linearise(FsmsModel.from_file(tmp_path / "tilted.toml"), "velocity")

@@ -8,6 +8,7 @@
 
 from rns_viz.analysis.authority import Authority, DecayFit, authority, fit_decay, loops_along
 from rns_viz.analysis.gain_map import (
+    G_M_MEANING,
     GAIN_RANGE,
     PAPER_GAINS,
     GainMap,
@@ -25,6 +26,7 @@ __all__ = [
     "BASE_SHARE",
     "EQUATIONS",
     "GAIN_RANGE",
+    "G_M_MEANING",
     "PAPER_GAINS",
     "Authority",
     "ClosedLoop",

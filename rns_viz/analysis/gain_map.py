@@ -29,6 +29,14 @@ GAIN_RANGE: dict[LawKind, tuple[float, float]] = {
 }
 
 
+# What g_m does in each law, for a view to say where the gain is set.
+G_M_MEANING: dict[LawKind, str] = {
+    "acceleration": "g_m (1/s): damping of the joint motion outside the RNS, -G_m theta' in (15)",
+    "torque": "g_m (1/s): damping of the joint motion outside the RNS, -G_m theta' in (16)",
+    "velocity": "g_m (1/s): position gain pulling the joints to their reference, g_m (theta_ref - theta) in (30)",
+}
+
+
 @dataclass(frozen=True)
 class PaperGains:
     label: str  # where the paper uses them

@@ -180,6 +180,9 @@ def linearise(
         raise ValueError(f"theta must be {model.n} finite joint angles (rad)")
     base = gains or Gains()
     loop = ClosedLoop(model, kind, theta, _with(base, 0.0, 0.0), dt)
+    drift = float(np.abs(loop.rhs(loop.x0)).max())
+    if not drift < 1e-9:  # e.g. gravity along a base axis loads the spring: x_b = 0 is no equilibrium
+        raise ValueError(f"{model.name}: theta at rest with x_b = 0 is not an equilibrium (|x'| = {drift:.3g})")
     A0 = loop.jacobian(view)
     loop.retune(_with(base, 1.0, 0.0))
     A_b = loop.jacobian(view) - A0
