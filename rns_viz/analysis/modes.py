@@ -63,7 +63,10 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     shape = np.broadcast_shapes(gb.shape, gm.shape)[:-2]
     A = (blocks[0] + gb * blocks[1] + gm * blocks[2]).reshape(-1, d, d)
     mu, V = np.linalg.eig(A[:, k:, k:])
-    W = np.linalg.inv(V)  # rows are the left eigenvectors, scaled so that W V = E
+    try:
+        W = np.linalg.inv(V)  # rows are the left eigenvectors, scaled so that W V = E
+    except np.linalg.LinAlgError:  # a defective pole somewhere in the batch (V singular there)
+        W = np.linalg.pinv(V)
     C = T[np.flatnonzero(loop.kept < loop.m)][:, k:]  # (m, seen): x_b on the observable block
     B = (T.T @ loop.impulse_input())[k:]  # (seen, m); C (sI - A)^-1 B involves this block only
     residue = np.linalg.norm(C @ V, axis=1) * np.linalg.norm(W @ B, axis=2)  # ||C v_i|| ||w_i^H B||
