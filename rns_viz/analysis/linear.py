@@ -24,7 +24,7 @@ add n eigenvalues 0 (mu = 1) and are dropped from the analysed matrices (``kept`
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -67,7 +67,7 @@ def build_law(model: FsmsModel, kind: LawKind, theta: np.ndarray, gains: Gains) 
 
 
 def _with(gains: Gains, g_b: float, g_m: float) -> Gains:
-    return Gains(**{**gains.__dict__, "g_b": g_b, "g_m": g_m})
+    return replace(gains, g_b=g_b, g_m=g_m)
 
 
 @dataclass(frozen=True)
