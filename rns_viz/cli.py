@@ -1,4 +1,4 @@
-"""Command line: ``rns-viz`` starts the app; ``rns-viz info|paths|run|figures`` work headless.
+"""Command line: ``rns-viz`` starts the app; ``rns-viz info|paths|run|gains|figures`` work headless.
 
 Bad arguments give one clear line on stderr and exit status 2, never a traceback.
 """
@@ -46,6 +46,15 @@ def _positive_float(text: str) -> float:
     if not (np.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"must be a positive finite number, got {text}")
     return value
+
+
+def _law_arg(text: str) -> str:
+    from rns_viz.analysis.linear import law_kind
+
+    try:
+        return law_kind(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _port(text: str) -> int:
@@ -153,6 +162,30 @@ def cmd_run(args: argparse.Namespace) -> None:
     print(f"{args.scenario}: {len(sim.log)} steps of {sim.dt * 1e3:g} ms, peak |x_b| = {xb.max():.3e} m; wrote {out}")
 
 
+def cmd_gains(args: argparse.Namespace) -> None:
+    from rns_viz.analysis import EQUATIONS, default_axes, gain_map
+
+    model = _load_model(args.model)
+    theta = None
+    if args.theta_deg is not None:
+        if len(args.theta_deg) != model.n:
+            raise CliError(f"--theta-deg needs {model.n} joint angles for {model.name}, got {len(args.theta_deg)}")
+        theta = np.deg2rad(args.theta_deg)
+    g_b, g_m = default_axes(args.law, args.size)
+    try:
+        result = gain_map(model, args.law, theta, g_b=g_b, g_m=g_m, view=args.view)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    out = Path(args.csv)
+    with _open_for_writing(out) as handle:
+        rows = result.write_csv(handle)
+    best_b, best_m, best_rate = result.best()
+    print(
+        f"{model.name}, law {EQUATIONS[result.loop.law]}: {rows} points, {result.stable.mean():.0%} stable; "
+        f"fastest base decay {best_rate:.3g} /s at g_b = {best_b:.3g}, g_m = {best_m:.3g} /s; wrote {out}"
+    )
+
+
 def cmd_figures(args: argparse.Namespace) -> None:
     from rns_viz.figures import FIGURES, draw_all
 
@@ -205,6 +238,18 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--csv", required=True, help="output file")
     run.add_argument("--duration", type=_positive_float, default=None, help="seconds (default: the preset's)")
     run.set_defaults(func=cmd_run)
+    gains = sub.add_parser("gains", help="map the closed loop's base and arm decay rates over g_b x g_m as CSV")
+    gains.add_argument("--model", type=_model_arg, default="trep", help=MODEL_HELP)
+    gains.add_argument("--law", type=_law_arg, default="velocity", help="15, 16, 30 or acceleration, torque, velocity")
+    gains.add_argument("--csv", required=True, help="output file (gains and rates in 1/s, see README)")
+    gains.add_argument("--size", type=_positive_int, default=60, help="grid points per axis (default 60)")
+    gains.add_argument(
+        "--theta-deg", type=float, nargs="+", default=None, help="the rest configuration, deg (default: the model's)"
+    )
+    gains.add_argument(
+        "--view", choices=("discrete", "continuous"), default="discrete", help="the 1 ms step map or continuous time"
+    )
+    gains.set_defaults(func=cmd_gains)
     figures = sub.add_parser("figures", help="draw the paper's figures (fig3, fig4, fig8, fig10, fig11, fig12) as PNG")
     figures.add_argument("--out", required=True, help="output directory")
     figures.add_argument("--only", nargs="*", help="a subset of the figures")

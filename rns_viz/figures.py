@@ -1,6 +1,7 @@
 """The paper's figures redrawn from our simulations (matplotlib, the optional ``figures`` extra).
 
-Each ``figN`` writes ``figN.png`` laid out like the paper's figure, axes in SI units.
+Each ``figN`` writes ``figN.png`` laid out like the paper's figure, axes in SI units;
+``gain_map_<model>`` writes the gain map of the model's law in the paper (rns_viz.analysis).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rns_viz.analysis import EQUATIONS, PAPER_GAINS, gain_map, modes_of
 from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family
 from rns_viz.scenarios import run_scenario
@@ -190,6 +192,51 @@ def fig12(out: Path) -> Path:
     )
 
 
+def _gain_map(out: Path, name: str, law: str) -> Path:
+    """Base and arm decay rates over g_b x g_m (1/s, log colour), unstable region grey, paper's gains marked."""
+    from matplotlib.colors import ListedColormap, LogNorm
+
+    model = FsmsModel.from_name(name)
+    result = gain_map(model, law)
+    loop = result.loop
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), sharey=True)
+    rates = (result.base_decay_rate, result.arm_decay_rate)
+    positive = np.concatenate([r[result.stable & (r > 0)] for r in rates])
+    norm = LogNorm(vmin=max(positive.min(), 1e-3), vmax=positive.max())
+    grey = ListedColormap(["0.6"])
+    for ax, rate, title in zip(axes, rates, ("base mode", "arm modes"), strict=True):
+        ax.pcolormesh(result.g_m, result.g_b, np.ma.masked_where(result.stable, rate), cmap=grey, shading="nearest")
+        shown = np.ma.masked_where(~result.stable | ~(rate > 0), rate)
+        image = ax.pcolormesh(result.g_m, result.g_b, shown, cmap="viridis", norm=norm, shading="nearest")
+        for k, mark in enumerate(PAPER_GAINS.get((name, loop.law), ())):
+            sigma = float(modes_of(loop, mark.g_b, mark.g_m).base_decay_rate)
+            ax.plot(mark.g_m, mark.g_b, "o", mfc="none", mec="tab:red", ms=9, mew=2)
+            text = f"{mark.label}: σ_b = {sigma:.2f}/s"
+            ax.annotate(text, (mark.g_m, mark.g_b), (8, 8 - 14 * k), textcoords="offset points", color="w", fontsize=8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(f"{title}: slowest decay rate σ [1/s] (grey: unstable)", fontsize=9)
+        ax.set_xlabel("g_m [1/s]")
+        fig.colorbar(image, ax=ax)
+    axes[0].set_ylabel("g_b [1/s]")
+    theta = np.round(np.rad2deg(loop.theta), 1).tolist()
+    fig.suptitle(
+        f"Gain map: {model.name}, law {EQUATIONS[loop.law]} at rest at θ = {theta} deg, 1 ms step map "
+        f"({result.stable.mean():.0%} of the grid stable)",
+        fontsize=10,
+    )
+    return _save(fig, out / f"gain_map_{name}.png")
+
+
+def gain_map_trep(out: Path) -> Path:
+    return _gain_map(out, "trep", "velocity")
+
+
+def gain_map_planar3r(out: Path) -> Path:
+    return _gain_map(out, "planar3r", "acceleration")
+
+
 FIGURES: dict[str, Callable[[Path], Path]] = {
     "fig3": fig3,
     "fig4": fig4,
@@ -197,6 +244,8 @@ FIGURES: dict[str, Callable[[Path], Path]] = {
     "fig10": fig10,
     "fig11": fig11,
     "fig12": fig12,
+    "gain_map_trep": gain_map_trep,
+    "gain_map_planar3r": gain_map_planar3r,
 }
 
 

@@ -1,0 +1,50 @@
+"""Gain analysis (issue 10): the closed loop of the simulator linearised in the gains (g_b, g_m).
+
+- :func:`linearise` -> :class:`LinearLoop`, A(g_b, g_m) = A0 + g_b A_b + g_m A_m about a rest configuration;
+- :func:`modes_of` -> :class:`Modes`, poles split into the base group and the arm group;
+- :func:`gain_map` / :func:`map_of` -> :class:`GainMap`, :func:`root_locus` -> :class:`Locus`;
+- :func:`loops_along` + :func:`authority` -> :class:`Authority` along a path; :func:`fit_decay` -> :class:`DecayFit`.
+"""
+
+from rns_viz.analysis.authority import Authority, DecayFit, authority, fit_decay, loops_along
+from rns_viz.analysis.gain_map import (
+    G_M_MEANING,
+    GAIN_RANGE,
+    PAPER_GAINS,
+    GainMap,
+    Locus,
+    PaperGains,
+    default_axes,
+    gain_map,
+    map_of,
+    root_locus,
+)
+from rns_viz.analysis.linear import EQUATIONS, ClosedLoop, LinearLoop, build_law, law_kind, linearise
+from rns_viz.analysis.modes import BASE_SHARE, Modes, modes_of
+
+__all__ = [
+    "BASE_SHARE",
+    "EQUATIONS",
+    "GAIN_RANGE",
+    "G_M_MEANING",
+    "PAPER_GAINS",
+    "Authority",
+    "ClosedLoop",
+    "DecayFit",
+    "GainMap",
+    "LinearLoop",
+    "Locus",
+    "Modes",
+    "PaperGains",
+    "authority",
+    "build_law",
+    "default_axes",
+    "fit_decay",
+    "gain_map",
+    "law_kind",
+    "linearise",
+    "loops_along",
+    "map_of",
+    "modes_of",
+    "root_locus",
+]
