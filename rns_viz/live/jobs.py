@@ -22,6 +22,8 @@ from typing import IO, Any
 
 import numpy as np
 
+from rns_viz.analysis import LinearLoop, linearise, loops_along
+from rns_viz.control import LawKind
 from rns_viz.live.path_table import PathTable, build_path_table
 from rns_viz.live.reach import ReachRegion, build_reach_region
 from rns_viz.model import FsmsModel
@@ -49,7 +51,17 @@ def reach_region(name: str, seed: np.ndarray) -> ReachRegion:
     return build_reach_region(_model(name), seed)
 
 
-JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region)}
+def linear_loop(name: str, law: LawKind, theta: np.ndarray) -> LinearLoop:
+    """The closed loop linearised in the gains about ``theta`` at rest (the gain explorer's map)."""
+    return linearise(_model(name), law, theta)
+
+
+def linear_loops(name: str, law: LawKind, thetas: np.ndarray) -> list[LinearLoop]:
+    """One linearised loop per configuration (the gain explorer's authority along a path)."""
+    return loops_along(_model(name), law, thetas)
+
+
+JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region, linear_loop, linear_loops)}
 
 
 class JobError(RuntimeError):

@@ -15,6 +15,7 @@ class ReachRegion:
     """End-effector points reachable without reaction from one configuration (base frame, m)."""
 
     points: np.ndarray  # (N, 3)
+    thetas: np.ndarray  # (N, n) rad: the configurations that reach them
     radius: float  # m: a target within this distance of a sample counts as reachable
     level: np.ndarray  # (r,) coupling potential of the configuration it was explored from, kg m
 
@@ -51,4 +52,4 @@ def build_reach_region(model: FsmsModel, theta: np.ndarray, spacing: float = 0.1
         d[d == 0.0] = np.inf
         radius = 1.5 * float(np.median(d.min(axis=1)))
     level = CouplingField(model).potentials(np.atleast_2d(theta))[0]
-    return ReachRegion(pts, radius, level)
+    return ReachRegion(pts, np.asarray(found.theta, dtype=float), radius, level)

@@ -12,8 +12,11 @@ from typing import Literal, NamedTuple
 import numpy as np
 
 from rns_viz.control import Gains, LawKind
+from rns_viz.defaults import defaults_for
 
 Level = Literal["info", "warning", "error"]
+UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)
+TARGET_SPEED = 0.5  # m/s: default speed limit of the smoothed target
 
 
 class Notice(NamedTuple):
@@ -38,6 +41,13 @@ class Settings:
     shadow: bool
     speed: float  # simulated seconds per wall second
     preset: str | None
+
+    @classmethod
+    def defaults(cls, model: str, shadow: bool, speed: float) -> Settings:
+        """A model's defaults (rns_viz.defaults), suppression on, no preset."""
+        law = defaults_for(model).law
+        gains = defaults_for(model).gains_for(law)
+        return cls(model, law, gains, True, UBAR_SPEED, TARGET_SPEED, shadow, speed, None)
 
 
 @dataclass(frozen=True)

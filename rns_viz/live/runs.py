@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.control import ControlOutput, Gains, JointSample, LawKind, TaskSample
+from rns_viz.live.guard import Bounds
 from rns_viz.live.kicks import KickSchedule
 from rns_viz.live.laws import LiveLaw, build_law
 from rns_viz.model import FsmsModel
@@ -124,6 +125,11 @@ class RunPair:
             except Exception as exc:
                 raise ShadowDiverged(f"the shadow run diverged ({exc}); restarted from the operated state") from exc
         return out
+
+    def violations(self, bounds: Bounds, shadow: bool) -> tuple[str | None, str | None]:
+        """Why the operated run (and the shadow, if shown) left physical bounds; None where it did not."""
+        why = bounds.violation(self.sim.q, self.sim.v)
+        return why, bounds.violation(self.shadow.q, self.shadow.v) if shadow else None
 
     def resync_shadow(self) -> None:
         """Restart the shadow from the operated run's state, with the same pending kicks."""

@@ -26,6 +26,7 @@ from types import MappingProxyType
 import numpy as np
 
 from rns_viz.live import commands as c
+from rns_viz.live.gain_explorer import GainView
 from rns_viz.live.pacing import MAX_BACKLOG_S, SPEEDS, Pacer
 from rns_viz.live.plots import PlotBuffers
 from rns_viz.live.records import Notice, Overlays, Snapshot
@@ -66,6 +67,10 @@ class Session:
     def overlays(self) -> Overlays:
         return self._overlays
 
+    def gain_view(self) -> GainView:
+        """The gain explorer's map, root loci, authority along the path and measured decay (``version`` counts)."""
+        return self.state.explorer.view
+
     @property
     def plots(self) -> PlotBuffers:
         """The live plots' buffers (read them with ``arrays()``; ``version`` bumps on each change)."""
@@ -104,7 +109,7 @@ class Session:
         self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
-        self.state.background.stop()
+        self.state.stop()
 
     # ================================================================ inputs (any thread)
     def send(self, command: c.Command) -> None:
@@ -200,7 +205,7 @@ class Session:
                 break
             if self._commands:
                 self._apply_commands()
-            if state.background.has_results():
+            if state.has_results():
                 state.collect()
             self._tick()
         self._apply_commands()
@@ -208,18 +213,18 @@ class Session:
 
     def wait_background(self, timeout: float = 30.0) -> bool:
         """Wait until the background jobs have finished and the loop has taken the results."""
-        background = self.state.background
+        state = self.state
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            if background.wait_idle(max(0.0, deadline - time.monotonic())):
+            if state.wait_idle(max(0.0, deadline - time.monotonic())):
                 if self._thread is None:
-                    self.state.collect()
+                    state.collect()
                     self._publish()
-                    if background.idle():
+                    if state.idle() and not state.has_results():
                         return True
-                elif not background.has_results():
+                elif not state.has_results():
                     time.sleep(0.01)
-                    if background.idle() and not background.has_results():
+                    if state.idle() and not state.has_results():
                         return True
             time.sleep(0.005)
         return False
@@ -262,7 +267,7 @@ class Session:
                 commanded = bool(self._commands)
                 if commanded:
                     self._apply_commands()
-                if state.background.has_results():
+                if state.has_results():
                     state.collect()
                     self._publish()
                 if state.paused or state.diverged:

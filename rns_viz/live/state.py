@@ -18,14 +18,17 @@ from rns_viz.control import Gains, LawKind
 from rns_viz.defaults import defaults_for
 from rns_viz.live import commands as c
 from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
+from rns_viz.live.gain_explorer import GainExplorer
+from rns_viz.live.geometry import Geometry
 from rns_viz.live.guard import GUARD_EVERY, Bounds
 from rns_viz.live.kicks import kick_pulse
 from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun, run_view
 from rns_viz.live.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
+from rns_viz.live.path_table import PathTable
 from rns_viz.live.readouts import arm_reach
-from rns_viz.live.records import Level, Notice, Overlays, Settings, Snapshot
+from rns_viz.live.records import Level, Notice, Settings, Snapshot
 from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
@@ -33,13 +36,6 @@ from rns_viz.paths import CouplingField
 from rns_viz.scenarios import SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
-UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)
-TARGET_SPEED = 0.5  # m/s: default speed limit of the smoothed target
-
-
-def default_settings(model: str, shadow: bool, speed: float) -> Settings:
-    law = defaults_for(model).law
-    return Settings(model, law, defaults_for(model).gains_for(law), True, UBAR_SPEED, TARGET_SPEED, shadow, speed, None)
 
 
 class LiveState:
@@ -47,13 +43,14 @@ class LiveState:
         self.pacer = pacer
         self.notices: deque[Notice] = deque(maxlen=100)
         self.background = Background()
+        self.geometry = Geometry(self.background)
+        self.explorer = GainExplorer()
         self.outputs = Outputs()
-        self._default_tables: dict[str, object] = {}
         self._gain_memory: dict[tuple[str, LawKind], Gains] = {}
-        self.epoch = self.settings_version = self.target_version = self.overlay_version = 0
+        self.epoch = self.settings_version = self.target_version = 0
         self.paused = False
         self.diverged: str | None = None
-        self.settings = default_settings(model, shadow, pacer.speed)
+        self.settings = Settings.defaults(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
         self.lesson: LessonRun | None = None
         self.kicks_sent = 0  # kicks since the session started (lessons count them)
@@ -87,16 +84,11 @@ class LiveState:
         self.settings = replace(self.settings, preset=None)
         self._restart_bookkeeping()
         op = self.operator
-        assert op is not None
-        if op.on_path:
-            table = self._default_tables.get(name)
-            if table is None or not op.accept_table(table, self.tol):  # type: ignore[arg-type]
-                self._request_geometry(theta0, default=True)
-            else:
-                self._current_path = table.ee  # type: ignore[attr-defined]
-            self.background.family(self.epoch, name)
+        table = self.geometry.default_tables.get(name)
+        if table is not None and op is not None and op.accept_table(table, self.tol):
+            self._took_table(table, default=True)
         else:
-            self._request_geometry(theta0)
+            self._request_geometry(theta0, default=True)
         self._overlays_changed()
 
     def _new_operator(self, theta: np.ndarray) -> None:
@@ -116,9 +108,7 @@ class LiveState:
         self.paused = False
         self.diverged = None
         self.pacer.reanchor(self.runs.t)
-        self._reach_points: np.ndarray | None = None
-        self._current_path: np.ndarray | None = None
-        self._shown_level: np.ndarray | None = None
+        self.geometry.restart()
         self._waiting_for_path: c.Command | None = None
         self.outputs.restart(self.model, self.runs.sim.q)
 
@@ -145,7 +135,7 @@ class LiveState:
         choice = runs.adopt_preset_laws()
         st = self.settings
         self.settings = replace(
-            default_settings(self.model.name, st.shadow, st.speed),
+            Settings.defaults(self.model.name, st.shadow, st.speed),
             law=choice.kind,
             gains=choice.gains,
             suppress=choice.suppress,
@@ -153,21 +143,20 @@ class LiveState:
         )
         self._restart_bookkeeping()
         self._request_geometry(runs.theta)
-        if self._one_dim:
-            self.background.family(self.epoch, self.model.name)
         self._overlays_changed()
 
-    @property
-    def _one_dim(self) -> bool:
-        return self.model.n - len(self.model.selected) == 1
-
     def _request_geometry(self, theta: np.ndarray, default: bool = False) -> None:
-        """The current reactionless path (1-D RNS) or reachable set (otherwise) through ``theta``."""
-        self._shown_level = self.field.potentials(np.asarray(theta, dtype=float)[None])[0]
-        if self._one_dim:
-            self.background.path_table(self.epoch, self.model.name, theta, default)
-        else:
-            self.background.reach(self.epoch, self.model.name, theta)
+        """The path or reachable set through ``theta``, and the gain analysis about it."""
+        self.geometry.request(self.model, self.field, self.epoch, theta, default)
+        self._explore(theta)
+
+    def _explore(self, theta: np.ndarray) -> None:
+        st = self.settings
+        self.explorer.context(self.model.name, st.law, theta, st.gains)
+
+    def _took_table(self, table: PathTable, default: bool) -> None:
+        self.geometry.took_table(self.model.name, table, default)
+        self.explorer.along(table.theta, table.ee)
 
     def notify(self, title: str, body: str, client: int | None = None, level: Level = "info") -> None:
         self.notices.append(Notice(title, body, client, level))
@@ -221,6 +210,7 @@ class LiveState:
                 duration = defaults_for(st.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m))
                 self.kicks_sent += 1
+                self.explorer.kicked(self.runs.t)
             case c.SetSuppression(on=on):
                 self.runs.set_suppression(on)
                 self.settings = replace(st, suppress=on)
@@ -232,10 +222,12 @@ class LiveState:
                     self._go_live()
                 else:
                     self._install_live_laws()
+                    self._explore(self.operator.theta_ref)
                 self.settings_version += 1
             case c.SetGains():
                 gains = cmd.applied_to(st.gains)
                 self.runs.retune(gains)
+                self.explorer.retune(gains)
                 self.settings = replace(st, gains=gains)
             case c.SetUbarSpeed(value=value) | c.SetTargetSpeed(value=value):
                 field = "ubar_speed" if isinstance(cmd, c.SetUbarSpeed) else "target_speed"
@@ -260,7 +252,7 @@ class LiveState:
                 self._go_live().point_to_point(self.runs.t)
                 self.target_version += 1
             case c.SwitchModel(model=name):
-                self.settings = default_settings(name, st.shadow, st.speed)
+                self.settings = Settings.defaults(name, st.shadow, st.speed)
                 self.start_live(name)
             case c.StartLesson(model=model, number=number):
                 lesson = LessonRun(model, number)
@@ -314,6 +306,8 @@ class LiveState:
             return False
         if k % SETTLE_EVERY == 0:
             self._check_settled()
+            if self.explorer.fit_due(runs.t):
+                self.explorer.measure(runs.sim)
         if self.lesson is not None and k % OBSERVE_EVERY == 0:
             counts, sigma = (self.kicks_sent, self.targets_moved), self.outputs.readouts.sigma_hbm
             view = run_view(self.model, self.epoch, runs, op, self.settings.shadow, counts, sigma)
@@ -322,17 +316,14 @@ class LiveState:
 
     def _out_of_bounds(self) -> bool:
         """Stop with a message if the operated run left physical bounds; restart a stray shadow run."""
-        sim, shadow = self.runs.sim, self.runs.shadow
-        why = self.bounds.violation(sim.q, sim.v)
+        why, why_shadow = self.runs.violations(self.bounds, self.settings.shadow)
         if why is not None:
-            self.fail(f"the simulation left physical bounds at t = {sim.t:.3f} s: {why}")
+            self.fail(f"the simulation left physical bounds at t = {self.runs.t:.3f} s: {why}")
             return True
-        if self.settings.shadow:
-            why = self.bounds.violation(shadow.q, shadow.v)
-            if why is not None:
-                self.runs.resync_shadow()
-                msg = f"the shadow run left physical bounds ({why}); restarted from the operated state"
-                self.notify("Shadow run restarted", msg, None, "warning")
+        if why_shadow is not None:
+            self.runs.resync_shadow()
+            msg = f"the shadow run left physical bounds ({why_shadow}); restarted from the operated state"
+            self.notify("Shadow run restarted", msg, None, "warning")
         return False
 
     def _check_settled(self) -> None:
@@ -345,7 +336,7 @@ class LiveState:
             return  # (30) pulls the arm back to theta_ref in every direction: nothing to re-anchor
         theta = sim.q[m:].copy()
         level = self.field.potentials(theta[None])[0]
-        reference_level = op.level if op is not None else self._shown_level
+        reference_level = op.level if op is not None else self.geometry.shown_level
         if reference_level is None or float(np.max(np.abs(level - reference_level))) <= self.tol:
             return
         if op is not None:
@@ -354,6 +345,19 @@ class LiveState:
         self._request_geometry(theta)
 
     # ================================================================ background results
+    def has_results(self) -> bool:
+        return self.background.has_results() or self.explorer.has_results()
+
+    def idle(self) -> bool:
+        return self.background.idle() and self.explorer.worker.idle()
+
+    def wait_idle(self, timeout: float) -> bool:
+        return self.background.wait_idle(timeout) and self.explorer.worker.wait_idle(timeout)
+
+    def stop(self) -> None:
+        self.background.stop()
+        self.explorer.stop()
+
     def collect(self) -> None:
         for ready in self.background.results(lambda: self.epoch):
             match ready:
@@ -364,13 +368,11 @@ class LiveState:
                 case FamilyReady():
                     self._overlays_changed()
                 case TableReady(table=table, default=default):
-                    if default:
-                        self._default_tables[self.model.name] = table
                     op = self.operator
                     if op is not None and not op.accept_table(table, self.tol):
                         self._request_geometry(op.theta_ref)  # theta_ref moved to another path meanwhile
                         continue
-                    self._current_path = table.ee
+                    self._took_table(table, default)
                     self._overlays_changed()
                     waiting, self._waiting_for_path = self._waiting_for_path, None
                     if waiting is not None:
@@ -378,17 +380,17 @@ class LiveState:
                 case ReachReady(region=region):
                     if self.operator is not None and not self.operator.on_path:
                         self.operator.reach = region
-                    self._reach_points = region.points
+                    self.geometry.took_reach(region)
+                    self.explorer.along(region.thetas, region.points)
                     self._overlays_changed()
+        self.explorer.collect()
 
     # ================================================================ outputs
     def _overlays_changed(self) -> None:
-        self.overlay_version += 1
-        family = self.background.families.get(self.model.name)
-        self.overlays = Overlays(family, self._current_path, self._reach_points, self.overlay_version)
+        self.overlays = self.geometry.overlays(self.model.name)
 
     def publish(self, realtime: bool) -> Snapshot:
-        versions = (self.epoch, self.settings_version, self.target_version, self.overlay_version)
+        versions = (self.epoch, self.settings_version, self.target_version, self.geometry.version)
         lesson = self.lesson.status() if self.lesson is not None else None
         rtf = 0.0 if self.paused else self.pacer.rtf() if realtime else math.nan
         flags = (self.paused, self.diverged, rtf, realtime and not self.paused and self.pacer.behind())

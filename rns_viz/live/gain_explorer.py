@@ -1,0 +1,192 @@
+"""The gain explorer of the live session: which gains damp the base, how fast, and where on the path.
+
+For the law and configuration in force, a background thread linearises the closed loop
+(:mod:`rns_viz.analysis`, the simulator's own 1 ms step map, in a helper process) and derives the
+g_b x g_m map of decay rates, the root loci through the current gains and the predicted decay along
+the current reactionless path (TREP) or over the reactionless-reachable set (3R). After a kick the
+loop fits the decay of the measured base deflection, to set beside the prediction.
+
+The loop calls :meth:`GainExplorer.context`, :meth:`retune`, :meth:`along`, :meth:`kicked` and
+:meth:`measure`; :meth:`collect` takes finished results. Readers take :attr:`GainExplorer.view`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from rns_viz.analysis import (
+    G_M_MEANING,
+    PAPER_GAINS,
+    Authority,
+    GainMap,
+    LinearLoop,
+    Locus,
+    Modes,
+    authority,
+    fit_decay,
+    map_of,
+    modes_of,
+    root_locus,
+)
+from rns_viz.control import Gains, LawKind
+from rns_viz.live import jobs
+from rns_viz.live.worker import Worker
+from rns_viz.sim import Simulator
+
+AUTHORITY_POINTS = 80  # configurations along the path / over the set where the decay is predicted
+FIT_FIRST_S = 4.0  # s after a kick before the first fit of the measured decay ...
+FIT_EVERY_S = 1.0  # ... and then every this many seconds ...
+FIT_UNTIL_S = 20.0  # ... until this long after it
+
+
+@dataclass(frozen=True)
+class Measured:
+    """The decay of the measured base deflection after the last kick."""
+
+    rate: float  # 1/s, fitted to the peaks of |x_b|
+    since: float  # s, the kick's time
+    seconds: float  # s of log fitted
+
+
+@dataclass(frozen=True)
+class GainView:
+    """What the explorer shows; a new object whenever something changed (``version`` counts)."""
+
+    version: int
+    model: str
+    law: LawKind
+    gains: Gains
+    g_m_meaning: str  # what g_m means in this law, one line
+    map: GainMap | None  # decay rates over the g_b x g_m grid (1/s)
+    current: Modes | None  # the poles at the gains in force
+    locus_g_b: Locus | None  # poles as g_b sweeps at the current g_m
+    locus_g_m: Locus | None  # poles as g_m sweeps at the current g_b
+    paper: tuple[tuple[str, float, float], ...]  # (label, g_b, g_m) of the paper's gains for this law
+    path_points: np.ndarray | None  # (K, 3) end-effector points (base frame, m) where authority is given
+    authority: Authority | None  # predicted decay there at the current gains
+    measured: Measured | None
+
+    @property
+    def predicted(self) -> float:
+        """The base decay rate predicted at the gains in force, 1/s (nan while it is computed)."""
+        return float(self.current.base_decay_rate) if self.current is not None else math.nan
+
+
+class GainExplorer:
+    def __init__(self) -> None:
+        self.worker = Worker()
+        self._loop: LinearLoop | None = None
+        self._loops: list[LinearLoop] | None = None
+        self._key: tuple[str, LawKind, bytes] | None = None
+        self.kick_t = math.nan  # s, the last kick
+        self._next_fit = math.inf
+        self.view = GainView(0, "", "velocity", Gains(), "", None, None, None, None, (), None, None, None)
+
+    # -- inputs from the loop --------------------------------------------------------------------
+    def context(self, model: str, law: LawKind, theta: np.ndarray, gains: Gains) -> None:
+        """Model, law or rest configuration changed: linearise anew (nothing is done if none changed)."""
+        theta = np.round(np.asarray(theta, dtype=float), 6)
+        key = (model, law, theta.tobytes())
+        self._publish(model=model, law=law, gains=gains, g_m_meaning=G_M_MEANING.get(law, ""))
+        if key == self._key:
+            return
+        self._key, self._loop, self._loops = key, None, None
+        paper = tuple((p.label, p.g_b, p.g_m) for p in PAPER_GAINS.get((model, law), ()))
+        self._publish(map=None, current=None, locus_g_b=None, locus_g_m=None, paper=paper, authority=None)
+
+        def job() -> tuple[LinearLoop, GainMap, tuple[Modes, Locus, Locus]]:
+            loop = jobs.call("linear_loop", model, law, theta)
+            return loop, map_of(loop), _at(loop, gains)
+
+        self.worker.submit("loop", key, job)
+
+    def retune(self, gains: Gains) -> None:
+        self._publish(gains=gains)
+        loop, loops = self._loop, self._loops
+        if loop is not None:
+            self.worker.submit("at", (self._key, gains), lambda: _at(loop, gains))
+        if loops is not None:
+            self.worker.submit("authority", (self._key, gains), lambda: authority(loops, gains.g_b, gains.g_m))
+
+    def along(self, thetas: np.ndarray, ee: np.ndarray) -> None:
+        """The configurations (K, n) and end-effector points (K, 3) of the current path or set."""
+        if self._key is None or len(thetas) == 0:
+            return
+        pick = np.unique(np.linspace(0, len(thetas) - 1, min(AUTHORITY_POINTS, len(thetas))).astype(int))
+        thetas, points = np.asarray(thetas, dtype=float)[pick], np.asarray(ee, dtype=float)[pick]
+        model, law, _ = self._key
+        gains = self.view.gains
+        self._publish(path_points=points, authority=None)
+
+        def job() -> tuple[list[LinearLoop], Authority]:
+            loops = jobs.call("linear_loops", model, law, thetas)
+            return loops, authority(loops, gains.g_b, gains.g_m)
+
+        self.worker.submit("along", self._key, job)
+
+    def kicked(self, t: float) -> None:
+        self.kick_t, self._next_fit = t, t + FIT_FIRST_S
+        self._publish(measured=None)
+
+    def fit_due(self, t: float) -> bool:
+        return t >= self._next_fit
+
+    def measure(self, sim: Simulator) -> None:
+        """Fit the decay since the last kick to the operated run's log of x_b; call when :meth:`fit_due`."""
+        t, log = sim.t, sim.log
+        self._next_fit = t + FIT_EVERY_S if t < self.kick_t + FIT_UNTIL_S else math.inf
+        rows = min(len(log), round((t - self.kick_t) / sim.dt) + 1)
+        times, x_b = log.column("t", rows), log.column("xb_1", rows)  # the first base coordinate
+        try:
+            fit = fit_decay(times, x_b, start=self.kick_t)
+        except ValueError:
+            return  # too few swings yet
+        self._publish(measured=Measured(fit.rate, self.kick_t, float(times[-1] - self.kick_t)))
+
+    # -- results -----------------------------------------------------------------------------------
+    def collect(self) -> bool:
+        """Take finished results; True if the view changed."""
+        changed = False
+        for res in self.worker.collect():
+            if res.error is not None:
+                continue  # an equilibrium that cannot be linearised: the view says nothing
+            key = res.tag if res.kind in ("loop", "along") else res.tag[0]
+            if key != self._key:
+                continue
+            changed = True
+            if res.kind == "loop":
+                self._loop, gain_map, at = res.value
+                self._publish(map=gain_map, **_at_fields(at))
+            elif res.kind == "at" and res.tag[1] == self.view.gains:
+                self._publish(**_at_fields(res.value))
+            elif res.kind == "along":
+                self._loops, found = res.value
+                self._publish(authority=found)
+            elif res.kind == "authority" and res.tag[1] == self.view.gains:
+                self._publish(authority=res.value)
+        return changed
+
+    def has_results(self) -> bool:
+        return self.worker.has_results()
+
+    def stop(self) -> None:
+        self.worker.stop()
+
+    def _publish(self, **changes: object) -> None:
+        self.view = replace(self.view, version=self.view.version + 1, **changes)  # type: ignore[arg-type]
+
+
+def _at(loop: LinearLoop, gains: Gains) -> tuple[Modes, Locus, Locus]:
+    """The poles at the gains in force and the two root loci through them."""
+    return (
+        modes_of(loop, gains.g_b, gains.g_m),
+        root_locus(loop, "g_b", gains.g_m),
+        root_locus(loop, "g_m", gains.g_b),
+    )
+
+
+def _at_fields(at: tuple[Modes, Locus, Locus]) -> dict[str, object]:
+    return {"current": at[0], "locus_g_b": at[1], "locus_g_m": at[2]}

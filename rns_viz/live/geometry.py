@@ -1,0 +1,53 @@
+"""The geometry the live session shows and the operator needs: the current reactionless path (1-D RNS)
+or reactionless-reachable set (otherwise) through the arm's configuration, and the path family.
+
+:class:`Geometry` asks the background for them, keeps what arrived and makes the overlays readers
+draw. The default configuration's path table is kept per model, so a reset needs no recomputation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rns_viz.live.background import Background
+from rns_viz.live.path_table import PathTable
+from rns_viz.live.reach import ReachRegion
+from rns_viz.live.records import Overlays
+from rns_viz.model import FsmsModel
+from rns_viz.paths import CouplingField
+
+
+class Geometry:
+    def __init__(self, background: Background) -> None:
+        self.background = background
+        self.default_tables: dict[str, PathTable] = {}
+        self.version = 0
+        self.restart()
+
+    def restart(self) -> None:
+        self.current_path: np.ndarray | None = None  # (k, 3) end-effector points of the current path, m
+        self.reach_points: np.ndarray | None = None  # (N, 3) reachable end-effector points, m
+        self.shown_level: np.ndarray | None = None  # coupling potential of what is shown, kg m
+
+    def request(
+        self, model: FsmsModel, field: CouplingField, epoch: int, theta: np.ndarray, default: bool = False
+    ) -> None:
+        """The current reactionless path (1-D RNS) or reachable set (otherwise) through ``theta``."""
+        self.shown_level = field.potentials(np.asarray(theta, dtype=float)[None])[0]
+        if model.n - len(model.selected) == 1:
+            self.background.path_table(epoch, model.name, theta, default)
+            self.background.family(epoch, model.name)
+        else:
+            self.background.reach(epoch, model.name, theta)
+
+    def took_table(self, model: str, table: PathTable, default: bool) -> None:
+        if default:
+            self.default_tables[model] = table
+        self.current_path = table.ee
+
+    def took_reach(self, region: ReachRegion) -> None:
+        self.reach_points = region.points
+
+    def overlays(self, model: str) -> Overlays:
+        self.version += 1
+        return Overlays(self.background.families.get(model), self.current_path, self.reach_points, self.version)
