@@ -29,7 +29,9 @@ MuJoCo adjustments needed to load the URDFs (see :func:`build_model`):
   must be larger than mjMINVAL"), which the point masses of planar3r.urdf have. Principal
   inertias of bodies with positive mass are raised to a floor of :data:`INERTIA_FLOOR` kg m^2
   (only where they are below it; TREP's inertias are untouched). The tests check that this
-  changes the base deflection by far less than 1e-9 m.
+  changes the base deflection by far less than 1e-9 m. For the same reason the massless links
+  between the coordinates of a multi-coordinate base (boom7's x, y, z, rx, ry) get a mass of
+  :data:`MASS_FLOOR` kg and inertias of INERTIA_FLOOR kg m^2: 1e-9 kg against a 22 kg system.
 - In MuJoCo 4.0 joint ``stiffness`` and ``damping`` are polynomial coefficient 3-vectors
   ``[a, b, c]`` with force -(a x + b x^2 + c x^3); only the linear coefficient ``a`` is set.
 - ``option.gravity = 0``, ``option.timestep = dt``, ``option.integrator = RK4`` and
@@ -58,6 +60,8 @@ import pinocchio as pin
 
 INERTIA_FLOOR = 1e-12
 """Lower bound (kg m^2) on the principal inertias of bodies with positive mass."""
+MASS_FLOOR = 1e-9
+"""Mass (kg) given to massless bodies that have a joint (MuJoCo rejects them)."""
 
 _STRIPPED_LINK_ELEMENTS = ("visual", "collision")
 
@@ -131,6 +135,11 @@ def _joint_or_tendons(matrix: np.ndarray, size: int, what: str) -> tuple[np.ndar
 def _floor_inertia(spec: mujoco.MjSpec, floor: float) -> None:
     """Raise principal inertias below ``floor`` for every body with positive mass."""
     for body in spec.bodies:
+        if body.mass <= 0.0 and body.first_joint() is not None:  # a massless link inside the base
+            body.explicitinertial = True
+            body.mass = MASS_FLOOR
+            body.inertia = [floor, floor, floor]
+            continue
         if body.mass <= 0.0:  # the world body and massless frames
             continue
         full = np.asarray(body.fullinertia, dtype=float)
