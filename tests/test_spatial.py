@@ -17,7 +17,7 @@ import scipy.linalg
 from rns_viz.control import AccelerationLaw, Gains, JointQuintic, JointServo, TaskQuintic, TrackEndEffector
 from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES, ModelFileError
-from rns_viz.paths import trace_paths
+from rns_viz.paths import nearby_seeds, null_vectors, path_family, trace_paths
 from rns_viz.rns import null_vector
 from rns_viz.scenarios import (
     BOOM7_DISPLACEMENT,
@@ -32,7 +32,7 @@ from rns_viz.sim import Simulator
 from rns_viz.sim.plant import Plant
 from tests.oracles.mujoco_replay import replay
 
-RUN_S = BOOM7_START_S + BOOM7_MOVE_S + 0.3  # s: every motion is over and settled by then
+RUN_S = BOOM7_START_S + BOOM7_MOVE_S + 0.1  # s: every motion is over by then
 # The boom of boom7.toml: aluminium tube, E, G in Pa, length, outer diameter and wall in m.
 E, G, L, D_OUT, WALL = 68.9e9, 26.0e9, 4.0, 0.100, 0.002
 
@@ -209,7 +209,7 @@ def test_momentum_balance_with_the_boom_wrench_as_the_only_external_load(boom7: 
     gravity off. W is integrated per step by the corrected trapezoid h/2 (W_0 + W_1) + h^2/12 (W_0' - W_1'),
     W' from the held torque's accelerations; dt is small enough to resolve the 168 Hz axial mode.
     """
-    dt, steps = 3e-5, 6000
+    dt, steps = 3e-5, 4000
     x0 = np.array([0.0, 2e-3, -3e-3, 1e-3, 1e-3, -1e-3])  # m and rad
     theta0 = boom7.spec.default_configuration
     sim = Simulator(boom7, AccelerationLaw(boom7, Gains(g_b=10.0, g_m=2.0)), dt=dt, q0=boom7.q(theta0, x0))
@@ -245,3 +245,17 @@ def test_momentum_balance_with_the_boom_wrench_as_the_only_external_load(boom7: 
         peak = np.linalg.norm(h[:, part], axis=1).max()
         assert peak > 0.05
         assert np.abs(error[:, part]).max() <= 1e-9 * peak
+
+
+def test_batched_null_vectors_and_the_3d_path_family(boom7: FsmsModel) -> None:
+    """null_vectors equals null_vector on a stack; path_family works without a coupling potential."""
+    thetas = nearby_seeds(boom7, boom7.spec.default_configuration, 5)
+    H = np.array([boom7.coupling_matrix(boom7.q(theta)) for theta in thetas])
+    assert np.allclose(null_vectors(H), [null_vector(h) for h in H], rtol=1e-12, atol=0)
+    assert np.allclose(np.linalg.norm(thetas - boom7.spec.default_configuration, axis=1), 0.3)
+    family = path_family(boom7, count=6, max_length=1.0)
+    assert len(family) == 6 and all(p.ee.shape == (len(p.s), 3) for p in family)
+    for path in family:
+        H = boom7.coupling_matrix(boom7.q(path.theta[len(path.s) // 2]))
+        t = null_vector(H)
+        assert np.linalg.norm(H @ t) <= 1e-9 * np.linalg.norm(H, 2) * np.linalg.norm(t)
