@@ -19,7 +19,7 @@ from rns_viz.control.common import CouplingEvaluator
 from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES, ModelFileError
 from rns_viz.paths import nearby_seeds, null_vectors, path_family, trace_paths
-from rns_viz.rns import null_vector
+from rns_viz.rns import check_integrability, null_vector
 from rns_viz.scenarios import (
     ALL_SCENARIOS,
     BOOM7_DISPLACEMENT,
@@ -299,3 +299,16 @@ def test_batched_null_vectors_and_the_3d_path_family(boom7: FsmsModel) -> None:
         H = boom7.coupling_matrix(boom7.q(path.theta[len(path.s) // 2]))
         t = null_vector(H)
         assert np.linalg.norm(H @ t) <= 1e-9 * np.linalg.norm(H, 2) * np.linalg.norm(t)
+
+
+def test_forces_only_rns_is_integrable_moments_only_is_not(boom7: FsmsModel) -> None:
+    """Sec. III-A, Frobenius: zero force reaction keeps the arm's centre of mass fixed on the tip, a
+    holonomic constraint (integrable RNS); zero moment reaction is angular momentum, which is not."""
+    samples = boom7.spec.default_configuration + np.random.default_rng(0).uniform(-0.3, 0.3, (3, 7))
+    results = {}
+    for name, selection in (("forces", [1, 1, 1, 0, 0, 0]), ("moments", [0, 0, 0, 1, 1, 1])):
+        model = boom7.with_selection(selection)
+        results[name] = check_integrability(lambda th, model=model: model.coupling_matrix(model.q(th)), samples)
+    assert results["forces"].integrable and results["forces"].rns_dim == 4
+    assert results["forces"].max_residual <= 1e-6
+    assert not results["moments"].integrable and results["moments"].max_residual >= 0.01
