@@ -16,6 +16,7 @@ import scipy.linalg
 
 from rns_viz.control import AccelerationLaw, Gains, JointQuintic, JointServo, TaskQuintic, TrackEndEffector
 from rns_viz.control.common import CouplingEvaluator
+from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES, ModelFileError
 from rns_viz.paths import nearby_seeds, null_vectors, path_family, trace_paths
@@ -228,6 +229,8 @@ def test_spatial_presets_are_apart_from_the_apps(boom7: FsmsModel) -> None:
     assert not set(SPATIAL_SCENARIOS) & set(SCENARIOS)
     assert ALL_SCENARIOS == {**SCENARIOS, **SPATIAL_SCENARIOS}
     assert all(s.model == "boom7" for s in SPATIAL_SCENARIOS.values())
+    gains = defaults_for("boom7").gains_for("acceleration")  # what the app will start with
+    assert (gains.g_b, gains.g_m) == (BOOM7_GAINS.g_b, BOOM7_GAINS.g_m)
 
 
 def test_damping_threshold_follows_sigma_min(boom7: FsmsModel) -> None:
