@@ -149,8 +149,10 @@ def cmd_run(args: argparse.Namespace) -> None:
         raise CliError(f"{args.scenario}: {exc}") from None
     with handle:
         sim.log.write_csv(handle)
-    xb = np.abs(sim.log.column("xb_1"))
-    print(f"{args.scenario}: {len(sim.log)} steps of {sim.dt * 1e3:g} ms, peak |x_b| = {xb.max():.3e} m; wrote {out}")
+    peaks = [float(np.abs(sim.log.column(f"xb_{i + 1}")).max()) for i in range(sim.model.m)]
+    unit = "m" if len(peaks) == 1 else "m or rad, per base coordinate"
+    shown = ", ".join(f"{p:.3e}" for p in peaks)
+    print(f"{args.scenario}: {len(sim.log)} steps of {sim.dt * 1e3:g} ms, peak |x_b| = {shown} {unit}; wrote {out}")
 
 
 def cmd_figures(args: argparse.Namespace) -> None:
