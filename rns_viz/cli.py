@@ -144,11 +144,11 @@ def cmd_paths(args: argparse.Namespace) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> None:
-    from rns_viz.scenarios import SCENARIOS, run_scenario
+    from rns_viz.scenarios import ALL_SCENARIOS, run_scenario
     from rns_viz.sim import SimulationDiverged
 
-    if args.scenario not in SCENARIOS:
-        raise CliError(f"unknown scenario {args.scenario!r}; choose one of: {', '.join(SCENARIOS)}")
+    if args.scenario not in ALL_SCENARIOS:
+        raise CliError(f"unknown scenario {args.scenario!r}; choose one of: {', '.join(ALL_SCENARIOS)}")
     out = Path(args.csv)
     handle = _open_for_writing(out)
     try:
@@ -158,8 +158,10 @@ def cmd_run(args: argparse.Namespace) -> None:
         raise CliError(f"{args.scenario}: {exc}") from None
     with handle:
         sim.log.write_csv(handle)
-    xb = np.abs(sim.log.column("xb_1"))
-    print(f"{args.scenario}: {len(sim.log)} steps of {sim.dt * 1e3:g} ms, peak |x_b| = {xb.max():.3e} m; wrote {out}")
+    peaks = [float(np.abs(sim.log.column(f"xb_{i + 1}")).max()) for i in range(sim.model.m)]
+    unit = "m" if len(peaks) == 1 else "m or rad, per base coordinate"
+    shown = ", ".join(f"{p:.3e}" for p in peaks)
+    print(f"{args.scenario}: {len(sim.log)} steps of {sim.dt * 1e3:g} ms, peak |x_b| = {shown} {unit}; wrote {out}")
 
 
 def cmd_gains(args: argparse.Namespace) -> None:
@@ -234,7 +236,11 @@ def build_parser() -> argparse.ArgumentParser:
     paths.add_argument("--csv", required=True, help="output file")
     paths.set_defaults(func=cmd_paths)
     run = sub.add_parser("run", help="run one of the paper's experiments headless and write its log as CSV")
-    run.add_argument("scenario", help="a preset: fig3, fig4, fig10-on/off, fig11-slow/fast/joint2, fig12-on/off")
+    run.add_argument(
+        "scenario",
+        help="a preset: fig3, fig4, fig10-on/off, fig11-slow/fast/joint2, fig12-on/off, "
+        "boom7-kick-on/off, boom7-path, boom7-track, boom7-p2p",
+    )
     run.add_argument("--csv", required=True, help="output file")
     run.add_argument("--duration", type=_positive_float, default=None, help="seconds (default: the preset's)")
     run.set_defaults(func=cmd_run)

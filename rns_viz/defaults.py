@@ -17,6 +17,11 @@ Kicks. "An arbitrary external force" (Sec. VII-D): a half-sine push on the base 
 0.8 N for 0.1 s, an impulse of 0.051 N s, about 5 mm of deflection. The 3R: 5 N for 0.2 s on its
 31 kg base (0.64 N s, about 1.1 cm); law (15) absorbs a deflection by moving the arm's centre of
 mass, so a much larger kick needs more than the arm's reach and drives it into H_bm = 0.
+
+boom7 (the spatial model; not yet served by the app): law (15) with g_b = 10, G_m = 2 on all six
+tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
+about 1.3 mm of a 4 m boom, drawn 50x). Its kick needs a direction: along the first base
+coordinate alone it would push the stiff axial mode (170 Hz, 1e-7 m).
 """
 
 from __future__ import annotations
@@ -65,6 +70,14 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         kick_duration_s=0.2,
         kick_range_N=50.0,
         exaggeration=20.0,
+    ),
+    "boom7": ModelDefaults(
+        law="acceleration",
+        gains={"acceleration": Gains(g_b=10.0, g_m=2.0), "torque": Gains(g_b=10.0, g_m=2.0)},
+        kick_peak_N=5.0,
+        kick_duration_s=0.1,
+        kick_range_N=20.0,
+        exaggeration=50.0,
     ),
 }
 GENERIC_DEFAULTS = ModelDefaults(law="acceleration")

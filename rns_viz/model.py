@@ -9,6 +9,7 @@ Jacobians); nothing is hand-derived.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -84,8 +85,12 @@ class FsmsModel:
 
     @classmethod
     def from_name(cls, name: str) -> FsmsModel:
-        """A bundled model: ``trep`` or ``planar3r``."""
+        """A bundled model: ``trep``, ``planar3r`` or ``boom7``."""
         return cls(load_spec(param_path_for(name)))
+
+    def with_selection(self, selection: Sequence[int | bool]) -> FsmsModel:
+        """The same system with another selection S: 0/1 flags over the base coordinates (Sec. III-B)."""
+        return FsmsModel(self.spec.with_selection(selection))
 
     @classmethod
     def from_file(cls, param_path: str | Path) -> FsmsModel:

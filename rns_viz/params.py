@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
-MODEL_NAMES = ("trep", "planar3r")
+MODEL_NAMES = ("trep", "planar3r")  # the models the live app serves
+BUNDLED_MODELS = (*MODEL_NAMES, "boom7")  # every model in assets/, for FsmsModel.from_name
 TASK_AXES = ("x", "y", "z")
 
 
@@ -55,11 +57,21 @@ class ModelSpec:
     base: BaseSpec
     joint_damping: np.ndarray  # D_m diagonal, N m s/rad
 
+    def with_selection(self, selection: Sequence[int | bool]) -> ModelSpec:
+        """The same system with another selection S (Sec. III-B): 0/1 flags over the m base coordinates."""
+        flags = np.asarray(selection)
+        m = self.base.dof
+        if flags.shape != (m,) or not np.all((flags == 0) | (flags == 1)) or not flags.any():
+            raise ModelFileError(
+                f"{self.name}: a selection needs {m} flags of 0 or 1, at least one 1; got {selection!r}"
+            )
+        return replace(self, base=replace(self.base, selection=flags.astype(bool)))
+
 
 def param_path_for(name: str) -> Path:
     """The parameter file of a bundled model, by name."""
-    if name not in MODEL_NAMES:
-        raise ModelFileError(f"unknown model {name!r}; choose one of: {', '.join(MODEL_NAMES)}")
+    if name not in BUNDLED_MODELS:
+        raise ModelFileError(f"unknown model {name!r}; choose one of: {', '.join(BUNDLED_MODELS)}")
     return ASSETS_DIR / f"{name}.toml"
 
 

@@ -1,7 +1,9 @@
-"""The paper's experiments as named presets (Sec. VI, Figs. 3-4; Sec. VII-D, Figs. 10-12).
+"""The paper's experiments as named presets (Sec. VI, Figs. 3-4; Sec. VII-D, Figs. 10-12), and the
+same ideas on the spatial model boom7 (m = 6, n = 7; Secs. II-V in general form).
 
 Each preset builds a ready :class:`Simulator` with the paper's parameters. Choices the paper
-leaves open are documented at the constants below.
+leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS,
+apart from SCENARIOS, until the live app serves that model; ``run_scenario`` runs both.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from rns_viz.control import (
     PathReference,
     TaskQuintic,
     TrackEndEffector,
+    TrackJointReference,
     VelocityLaw,
 )
 from rns_viz.control.hold import JointServo, Switched
@@ -27,6 +30,7 @@ from rns_viz.control.reference import path_integral_to
 from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import CyclicUbar, QuinticUbar
+from rns_viz.rns import null_vector
 from rns_viz.sim import ForcePulse, Simulator
 
 # "An arbitrary external force" (Sec. VII-D): the kicks of rns_viz.defaults (why these sizes: there).
@@ -163,11 +167,105 @@ SCENARIOS: dict[str, Scenario] = {
 }
 
 
+# -- boom7: a 7-DOF arm on a boom tip with six elastic coordinates (assets/boom7.toml) -------------
+# A kick in every direction: half-sine, 0.1 s, forces (N) along the tip's x, y, z and moments (N m)
+# about them; about 1.3 mm and 0.5 mrad of tip deflection. Law (15) absorbs it by moving the arm
+# (joint 1 turns by 20 deg): a kick much larger drives the wrist through its joint limits, since
+# the moment rows of H_bm are small (sigma_min(H_bm) = 0.044 kg m^2 at theta_0).
+BOOM7_KICK = dict(start=0.1, duration=0.1, peak=(2.0, 5.0, 5.0, 0.5, 0.5, 0.5))
+# (15): g_b = 10 /s on all six modes, G_m = 2 /s; end-effector gains G_p = 400 /s^2, G_d = 40 /s
+# (critically damped error, 20 /s); joint reference gains k_p = 400 /s^2, k_d = 40 /s.
+BOOM7_GAINS = Gains(g_b=10.0, g_m=2.0, G_p=400.0, G_d=40.0, k_p=400.0, k_d=40.0)
+BOOM7_START_S = 0.2  # s: motions start here
+BOOM7_MOVE_S = 1.5  # s: duration of every boom7 motion (path, tracking, point to point)
+BOOM7_PATH_ARC = 1.5  # rad: joint-space length of the r = 6 path, sigma = arc / |n(theta_0)|
+# End-effector displacement (m, tip frame) for forces-only tracking: S selects x, y, z only (r = 3,
+# a 4-D RNS), so the three task rows leave one redundant direction; from the default configuration,
+# where sigma_min of J-bar is 0.098 m/rad, this path keeps it above 0.05 m/rad.
+BOOM7_DISPLACEMENT = np.array([0.08, 0.06, 0.06])
+FORCES_ONLY = (1, 1, 1, 0, 0, 0)  # S: reactions x, y, z must vanish; moments rx, ry, rz are free
+
+
+def _boom7(selection: tuple[int, ...] | None = None) -> FsmsModel:
+    model = FsmsModel.from_name("boom7")
+    return model if selection is None else model.with_selection(selection)
+
+
+def boom7_kick(suppress: bool) -> Simulator:
+    """Kick in all six directions; (15) suppresses all six modes (S = E), or the joints are held."""
+    model = _boom7()
+    theta0 = model.spec.default_configuration
+    held = JointServo(model, BOOM7_GAINS, FixedReference(theta0))
+    law = AccelerationLaw(model, BOOM7_GAINS) if suppress else held
+    return Simulator(model, law, force=ForcePulse(**BOOM7_KICK), q0=model.q(theta0))
+
+
+def boom7_path_reference(model: FsmsModel) -> PathReference:
+    """theta_ref' = n u-bar along the r = 6 reactionless path from theta_0, quintic u-bar (Eq. 30's integral)."""
+    theta0 = model.spec.default_configuration
+    sigma = BOOM7_PATH_ARC / float(np.linalg.norm(null_vector(model.coupling_matrix(model.q(theta0)))))
+    return PathReference(model, theta0, QuinticUbar(sigma, BOOM7_MOVE_S, start=BOOM7_START_S))
+
+
+def boom7_path() -> Simulator:
+    """r = 6: law (15) tracking the reactionless path in the 1-D RNS (P_RNS u, Eq. 15)."""
+    model = _boom7()
+    reference = TrackJointReference(boom7_path_reference(model), BOOM7_GAINS.k_p, BOOM7_GAINS.k_d)
+    law = AccelerationLaw(model, BOOM7_GAINS, null_input=reference)
+    return Simulator(model, law)
+
+
+def boom7_track() -> Simulator:
+    """r = 3: reactionless end-effector tracking with forces only, Eq. (24), moments left free."""
+    model = _boom7(FORCES_ONLY)
+    start = model.ee_position(model.spec.default_configuration)
+    task = TaskQuintic(start, start + BOOM7_DISPLACEMENT, BOOM7_MOVE_S, t0=BOOM7_START_S)
+    law = AccelerationLaw(
+        model, BOOM7_GAINS, null_input=TrackEndEffector(model, task, BOOM7_GAINS.G_p, BOOM7_GAINS.G_d)
+    )
+    return Simulator(model, law)
+
+
+@cache
+def boom7_track_end() -> tuple[float, ...]:
+    """Joint angles (rad) where forces-only tracking ends: the point-to-point motion's end point."""
+    sim = boom7_track()
+    sim.run(BOOM7_START_S + BOOM7_MOVE_S + 0.3)
+    return tuple(sim.q[sim.model.m :])
+
+
+def boom7_point_to_point(selection: tuple[int, ...] = FORCES_ONLY) -> Simulator:
+    """The same end points as the tracking, by a joint-space quintic of the same duration."""
+    model = _boom7(selection)
+    theta0 = model.spec.default_configuration
+    quintic = JointQuintic(theta0, np.array(boom7_track_end()), BOOM7_MOVE_S, t0=BOOM7_START_S)
+    return Simulator(model, JointServo(model, BOOM7_GAINS, quintic))
+
+
+SPATIAL_SCENARIOS: dict[str, Scenario] = {
+    s.name: s
+    for s in (
+        Scenario(
+            "boom7-kick-on",
+            "boom7",
+            5.0,
+            "boom7: kick in 6 directions, (15) suppresses all six modes",
+            lambda: boom7_kick(True),
+        ),
+        Scenario("boom7-kick-off", "boom7", 5.0, "boom7: kick in 6 directions, joints held", lambda: boom7_kick(False)),
+        Scenario("boom7-path", "boom7", 3.0, "boom7: reactionless path with r = 6 (1-D RNS), law (15)", boom7_path),
+        Scenario("boom7-track", "boom7", 3.0, "boom7: end-effector tracking (24), forces only (r = 3)", boom7_track),
+        Scenario("boom7-p2p", "boom7", 3.0, "boom7: same end points, joint-space quintic", boom7_point_to_point),
+    )
+}
+ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS}
+
+
 def run_scenario(name: str, duration: float | None = None) -> Simulator:
-    """Build and run a preset; returns the simulator (its ``log`` holds every step)."""
-    if name not in SCENARIOS:
-        raise KeyError(f"unknown scenario {name!r}; choose one of: {', '.join(SCENARIOS)}")
-    scenario = SCENARIOS[name]
+    """Build and run a preset (paper or spatial); returns the simulator (its ``log`` holds every step)."""
+    if name not in ALL_SCENARIOS:
+        raise KeyError(f"unknown scenario {name!r}; choose one of: {', '.join(ALL_SCENARIOS)}")
+    scenario = ALL_SCENARIOS[name]
     sim = scenario.build()
     total = scenario.duration if duration is None else duration
     sim.resize_log(round(total / sim.dt) + 1)

@@ -216,8 +216,8 @@ XY_BASE_URDF = """<?xml version="1.0"?>
 """
 
 
-def test_two_dof_base_diagonal_accepted_coupled_rejected(tmp_path: Path) -> None:
-    """A 2-DOF base: diagonal K_b, D_b map to joint springs; coupled ones raise NotImplementedError."""
+def test_two_dof_base_diagonal_joint_springs_coupled_tendons(tmp_path: Path) -> None:
+    """A 2-DOF base: diagonal K_b, D_b map to joint springs; coupled ones to tendons giving -K x - D x'."""
     urdf = tmp_path / "xy_base.urdf"
     urdf.write_text(XY_BASE_URDF)  # also: a mesh visual that MuJoCo could not load is stripped
     K = np.diag([50.0, 80.0])
@@ -227,10 +227,19 @@ def test_two_dof_base_diagonal_accepted_coupled_rejected(tmp_path: Path) -> None
     assert np.allclose(plant.model.dof_damping[plant.dof_index], [0.1, 0.2, 0.01])
     q, _ = simulate(plant, np.array([0.01, -0.02, 0.5]), np.zeros(3), np.zeros((10, 1)), np.ones((10, 2)))
     assert q.shape == (11, 3) and np.all(np.isfinite(q))
-    with pytest.raises(NotImplementedError):
-        build_model(urdf, ["bx", "by"], np.array([[50.0, 5.0], [5.0, 80.0]]), D, [0.01], DT)
-    with pytest.raises(NotImplementedError):
-        build_model(urdf, ["bx", "by"], K, np.array([[0.1, 0.01], [0.01, 0.2]]), [0.01], DT)
+    K_c, D_c = np.array([[50.0, -30.0], [-30.0, 80.0]]), np.array([[0.1, 0.05], [0.05, 0.2]])
+    coupled = build_model(urdf, ["bx", "by"], K_c, D_c, [0.01], DT)
+    assert coupled.model.ntendon == 4 and not np.any(coupled.model.jnt_stiffness)
+    data = mujoco.MjData(coupled.model)
+    x, xdot = np.array([0.01, -0.02]), np.array([0.3, 0.7])
+    data.qpos[coupled.qpos_index[:2]], data.qvel[coupled.dof_index[:2]] = x, xdot
+    mujoco.mj_forward(coupled.model, data)
+    passive = data.qfrc_passive[coupled.dof_index[:2]]
+    assert np.allclose(passive, -K_c @ x - D_c @ xdot, rtol=1e-12, atol=1e-12)
+    with pytest.raises(ValueError, match="symmetric"):
+        build_model(urdf, ["bx", "by"], np.array([[50.0, 5.0], [4.0, 80.0]]), D, [0.01], DT)
+    with pytest.raises(ValueError, match="semi-definite"):
+        build_model(urdf, ["bx", "by"], np.array([[50.0, 90.0], [90.0, 80.0]]), D, [0.01], DT)
     with pytest.raises(ValueError, match="shape"):
         build_model(urdf, ["bx", "by"], np.eye(3), D, [0.01], DT)
     with pytest.raises(ValueError, match="first joints"):

@@ -204,10 +204,12 @@ class CouplingEvaluator:
         self._rows: slice | np.ndarray = slice(0, m) if all_rows else self.rows
         self._H_b_index = (slice(0, m), slice(0, m)) if all_rows else np.ix_(self.rows, self.rows)
         self._single_row = len(self.rows) == 1
-        # Damping starts below 10 % of the coupling at the default configuration (kg m) and
-        # reaches that same value at rank loss, so |H_bm^+| <= 1 / (2 lambda) = 5 / |H_bm(theta_0)|.
+        # Damping starts below 10 % of sigma_min(S H_bm) at the default configuration (kg m or kg m^2;
+        # |h| for one row) and reaches that same value at rank loss, so |H_bm^+| <= 5 / sigma_min(theta_0).
+        # sigma_min, not the norm: a 6-row coupling mixes kg m and kg m^2 rows and its sigma_min is
+        # far below its norm (boom7: 0.034 vs 6), where a norm-based threshold would damp every step.
         q0 = model.q(model.spec.default_configuration)
-        scale = float(np.linalg.norm(model.coupling_matrix(q0)))
+        scale = float(np.linalg.svd(model.coupling_matrix(q0), compute_uv=False)[-1])
         self.threshold = singular_threshold if singular_threshold is not None else 0.1 * max(scale, 1e-9)
         self.max_damping = self.threshold
 

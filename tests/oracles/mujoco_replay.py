@@ -11,6 +11,10 @@ with MuJoCo's own RK4 integrator, zero gravity, no contacts and no joint limits:
 - K_b, D_b (diagonal) become the MuJoCo joint ``stiffness`` / ``damping`` of the base joints, with
   the spring at rest at x_b = 0 (``springref`` 0); D_m becomes the arm joints' ``damping``. They
   are passive forces, so MuJoCo evaluates them at every RK4 stage, like a plain RK4 of the ODE.
+- A coupled (symmetric, positive semi-definite) K_b or D_b, such as a cantilever's tip stiffness,
+  is split as sum_j lambda_j a_j a_j^T (eigen-decomposition) into fixed tendons of length
+  l_j = a_j . x_b, stiffness (or damping) lambda_j and rest length 0: their passive force
+  -lambda_j a_j (a_j . x_b) sums to -K_b x_b, again evaluated at every stage.
 - tau and f_ext go through ``data.qfrc_applied``, which MuJoCo's RK4 keeps constant across the
   four stages of a step: the held-torque convention of our simulator.
 
@@ -25,7 +29,9 @@ MuJoCo adjustments needed to load the URDFs (see :func:`build_model`):
   must be larger than mjMINVAL"), which the point masses of planar3r.urdf have. Principal
   inertias of bodies with positive mass are raised to a floor of :data:`INERTIA_FLOOR` kg m^2
   (only where they are below it; TREP's inertias are untouched). The tests check that this
-  changes the base deflection by far less than 1e-9 m.
+  changes the base deflection by far less than 1e-9 m. For the same reason the massless links
+  between the coordinates of a multi-coordinate base (boom7's x, y, z, rx, ry) get a mass of
+  :data:`MASS_FLOOR` kg and inertias of INERTIA_FLOOR kg m^2: 1e-9 kg against a 22 kg system.
 - In MuJoCo 4.0 joint ``stiffness`` and ``damping`` are polynomial coefficient 3-vectors
   ``[a, b, c]`` with force -(a x + b x^2 + c x^3); only the linear coefficient ``a`` is set.
 - ``option.gravity = 0``, ``option.timestep = dt``, ``option.integrator = RK4`` and
@@ -54,6 +60,8 @@ import pinocchio as pin
 
 INERTIA_FLOOR = 1e-12
 """Lower bound (kg m^2) on the principal inertias of bodies with positive mass."""
+MASS_FLOOR = 1e-9
+"""Mass (kg) given to massless bodies that have a joint (MuJoCo rejects them)."""
 
 _STRIPPED_LINK_ELEMENTS = ("visual", "collision")
 
@@ -111,9 +119,27 @@ def _diagonal(matrix: np.ndarray, size: int, what: str) -> np.ndarray:
     return diag
 
 
+def _joint_or_tendons(matrix: np.ndarray, size: int, what: str) -> tuple[np.ndarray, list[tuple[float, np.ndarray]]]:
+    """Per-joint diagonal of a diagonal matrix, or zeros and (lambda_j, a_j) tendons of a coupled one."""
+    arr = np.asarray(matrix, dtype=float)
+    if arr.shape != (size, size) or np.all(arr == np.diag(np.diag(arr))):
+        return _diagonal(arr, size, what), []
+    if not (np.all(np.isfinite(arr)) and np.array_equal(arr, arr.T)):
+        raise ValueError(f"{what} must be finite and symmetric")
+    values, vectors = np.linalg.eigh(arr)
+    if values.min() < -1e-12 * values.max():
+        raise ValueError(f"{what} must be positive semi-definite")
+    return np.zeros(size), [(float(v), vectors[:, j]) for j, v in enumerate(values) if v > 0.0]
+
+
 def _floor_inertia(spec: mujoco.MjSpec, floor: float) -> None:
     """Raise principal inertias below ``floor`` for every body with positive mass."""
     for body in spec.bodies:
+        if body.mass <= 0.0 and body.first_joint() is not None:  # a massless link inside the base
+            body.explicitinertial = True
+            body.mass = MASS_FLOOR
+            body.inertia = [floor, floor, floor]
+            continue
         if body.mass <= 0.0:  # the world body and massless frames
             continue
         full = np.asarray(body.fullinertia, dtype=float)
@@ -140,7 +166,7 @@ def build_model(
 
     stiffness, damping: K_b, D_b, (m, m) diagonal (or (m,)), N/m or N m/rad, N s/m or N m s/rad.
     joint_damping: D_m, (n,) or (n, n) diagonal, N m s/rad. dt: time step, s.
-    Raises NotImplementedError for a non-diagonal K_b, D_b or D_m.
+    A coupled K_b or D_b becomes fixed tendons; raises NotImplementedError for a non-diagonal D_m.
     """
     path = Path(urdf_path)
     names = pinocchio_joint_names(path)
@@ -153,8 +179,8 @@ def build_model(
         raise ValueError(f"{path}: no arm joints after the base joints")
     if not dt > 0.0:
         raise ValueError(f"dt must be positive, got {dt}")
-    k_b = _diagonal(stiffness, m, "stiffness K_b")
-    d_b = _diagonal(damping, m, "damping D_b")
+    k_b, k_tendons = _joint_or_tendons(stiffness, m, "stiffness K_b")
+    d_b, d_tendons = _joint_or_tendons(damping, m, "damping D_b")
     d_m = _diagonal(joint_damping, n, "joint damping D_m")
 
     spec = mujoco.MjSpec.from_string(_urdf_text_for_mujoco(path))
@@ -180,6 +206,15 @@ def build_model(
         joint.armature = 0.0
         joint.frictionloss = 0.0
         joint.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+
+    for kind, tendons in (("stiffness", k_tendons), ("damping", d_tendons)):
+        for value, axis in tendons:
+            tendon = spec.add_tendon()
+            setattr(tendon, kind, [value, 0.0, 0.0])
+            tendon.springlength = [0.0, 0.0]
+            for name, coef in zip(base_joints, axis, strict=True):
+                if coef != 0.0:
+                    tendon.wrap_joint(name, float(coef))
 
     model = spec.compile()
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in names]
@@ -266,8 +301,8 @@ def replay(
     force on the base coordinates held over step k (or None). Returns (q, v) arrays of shape (N+1, m+n):
     the state at t = 0, dt, ..., N dt, integrated by MuJoCo's RK4 integrator.
 
-    stiffness K_b and damping D_b: (m, m), must be diagonal (NotImplementedError otherwise), the
-    spring at rest at x_b = 0; joint_damping D_m: (n,) or diagonal (n, n). Gravity is zero;
+    stiffness K_b and damping D_b: (m, m), symmetric positive semi-definite, the
+    spring at rest at x_b = 0 (coupled: fixed tendons); joint_damping D_m: (n,) or diagonal (n, n). Gravity is zero;
     joint limits and contacts are ignored. SI units; dt in s.
     """
     plant = build_model(urdf_path, base_joints, stiffness, damping, joint_damping, dt)
