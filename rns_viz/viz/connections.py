@@ -26,14 +26,17 @@ class Connections:
         self.lock = OperatorLock(password)
         self.panels = OperatorPanels(self.lock, self.notify)
 
+    def recipients(self, client: viser.ClientHandle | None) -> list[viser.ClientHandle]:
+        """``client`` itself, or every connected client for the server's own input (None)."""
+        return [client] if client is not None else list(self.server.get_clients().values())
+
     def notify(self, client: viser.ClientHandle | None, title: str, body: str, level: str) -> None:
         """Show a notification to ``client``, or to every client when it is None."""
-        clients = [client] if client is not None else list(self.server.get_clients().values())
-        for c in clients:
+        for c in self.recipients(client):
             with suppress(Exception):  # the client may have gone
                 c.add_notification(title, body, color=NOTICE_COLOURS.get(level), auto_close_seconds=NOTICE_SECONDS)
 
-    def notify_id(self, client_id: int | None, title: str, body: str, level: str) -> None:
+    def notify_by_id(self, client_id: int | None, title: str, body: str, level: str) -> None:
         """Like :meth:`notify`, by client id; nothing if that client has left."""
         client = None
         if client_id is not None:
@@ -55,7 +58,7 @@ class Connections:
             body += " Taking control needs the session password."
         self.notify(client, "View only", body, "warning")
 
-    def crowd(self) -> int:
+    def client_count(self) -> int:
         return len(self.server.get_clients())
 
     def client_joined(self, client: viser.ClientHandle) -> None:

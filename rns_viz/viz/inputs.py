@@ -167,8 +167,7 @@ class Controls:
             return
         data = self.session.log_csv()
         name = f"rns_{self.session.snapshot().settings.model}_log.csv"
-        clients = [event.client] if event.client is not None else list(self.connections.server.get_clients().values())
-        for client in clients:
+        for client in self.connections.recipients(event.client):
             client.send_file_download(name, data, save_immediately=True)
 
     # ---------------------------------------------------------------- the target handle

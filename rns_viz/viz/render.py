@@ -45,13 +45,18 @@ class Renderer:
     """The scene of the session's model, the target handle, and the loop that keeps both current."""
 
     def __init__(
-        self, server: viser.ViserServer, session: Session, gui: GuiElements, controls: Controls, clients: Connections
+        self,
+        server: viser.ViserServer,
+        session: Session,
+        gui: GuiElements,
+        controls: Controls,
+        connections: Connections,
     ) -> None:
         self.server = server
         self.session = session
         self.gui = gui
         self.controls = controls
-        self.clients = clients
+        self.connections = connections
         self.scene_updates = 0  # frames in which the scene was sent
         self.plot_updates = 0
         snap = session.snapshot()
@@ -114,10 +119,10 @@ class Renderer:
         while not self._stop.is_set():
             try:
                 self._frame(next_time)
-                self.clients.panels.refresh()
+                self.connections.panels.refresh()
             except Exception:  # drawing must never kill the app
                 traceback.print_exc()
-            next_time += CROWDED_FRAME_S if self.clients.crowd() >= CROWD else FRAME_S
+            next_time += CROWDED_FRAME_S if self.connections.client_count() >= CROWD else FRAME_S
             delay = next_time - time.perf_counter()
             if delay < -0.1:
                 next_time = time.perf_counter()
@@ -139,7 +144,7 @@ class Renderer:
             seen.target_version = -1
         self._draw_target(snap)
         for notice in self.session.pop_notices():
-            self.clients.notify_id(notice.client, notice.title, notice.body, notice.level)
+            self.connections.notify_by_id(notice.client, notice.title, notice.body, notice.level)
         if self.controls.apply_reverts() or snap.settings_version != seen.settings_version:
             seen.settings_version = snap.settings_version
             self.sync_settings(snap)
