@@ -1,6 +1,6 @@
 """Real-browser helpers: Debian chromium driven by Playwright against a local viser server.
 
-Recipe (DESIGN.md §8): ``/usr/bin/chromium`` (apt), never ``playwright install``; headless with
+Recipe (docs/testing-notes.md): ``/usr/bin/chromium`` (apt), never ``playwright install``; headless with
 software rendering (SwiftShader), a fresh user-data-dir per browser. Scene nodes are read from
 the client's ``window.__viserMutable.nodeRefFromName`` (viser/client/src/App.tsx exposes it).
 """

@@ -5,7 +5,7 @@ the browser does (msgpack dicts built by viser's own message classes: camera rep
 transform drags) and drains what the server sends on a background thread, counting messages and
 bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack windows and
 counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
-element (update rates for benchmarks). Only connects to loopback addresses (DESIGN.md section 8).
+element (update rates for benchmarks). Only connects to loopback addresses (docs/testing-notes.md says why).
 """
 
 from __future__ import annotations

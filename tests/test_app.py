@@ -3,7 +3,7 @@
 Inputs go through the app's own GUI handles and scene handle, either set on the server or sent by
 a protocol-level websocket client (tests/protocol_client.py), so viser's real callback path runs. The
 session is made with ``realtime=False`` and advanced faster than real time with ``advance()``;
-one test checks the wall-clock pacing itself.
+one test runs the real-time loop, and one (marked ``perf``, not in the default run) checks its timing.
 """
 
 from __future__ import annotations
@@ -359,6 +359,24 @@ def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: Proto
         other.close()
 
 
+def test_real_time_loop_runs_applies_inputs_and_publishes() -> None:
+    """The real-time loop, what it does (its timing is test_real_time_pacing_and_latency's, perf)."""
+    app = start_app("trep", port=0, realtime=True, verbose=False)
+    try:
+        s = app.session
+        wait_until(lambda: s.snapshot().t > 0.2, 10.0, "simulated time to advance")
+        for k in range(5):
+            s.scrub(float(k))
+        wait_until(lambda: len(s.latencies()) >= 5, 10.0, "the scrubs to reach a step")
+        s.set_speed(0.5)
+        wait_until(lambda: s.snapshot().settings.speed == 0.5, 10.0, "the speed change")
+        wait_until(lambda: app.scene_updates > 0 and app.plot_updates > 0, 10.0, "scene and plot updates")
+        assert not s.snapshot().paused and s.snapshot().diverged is None
+    finally:
+        app.stop()
+
+
+@pytest.mark.perf
 def test_real_time_pacing_and_latency() -> None:
     app = start_app("trep", port=0, realtime=True, verbose=False)
     try:

@@ -1,7 +1,8 @@
 """Many clients, real time: 8 protocol-level clients come and go at random while one drags the target.
 
-No exception reaches the server log, the simulation keeps real time, and the operator lock passes on
-when the operator's connection dies mid-drag (the target stays where it was).
+No exception reaches the server log and the operator lock passes on when the operator's connection
+dies mid-drag (the target stays where it was). That the simulation keeps real time meanwhile is a
+separate test marked ``perf`` (not in the default run: a busy machine must not fail it).
 
 The six churning clients run in a process of their own, as browser tabs do: in this process their
 websocket threads would compete with the server for the interpreter lock, which no real client does.
@@ -16,6 +17,7 @@ import subprocess
 import sys
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -69,10 +71,20 @@ def new_client(app: object, port: int) -> tuple[ProtocolClient, int]:
     return c, cid
 
 
-def test_eight_clients_come_and_go_while_one_drags(
-    capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
-) -> None:
-    caplog.set_level(logging.WARNING)
+@dataclass
+class Churn:
+    """What one run of the churn measured: overall and windowed real-time factors."""
+
+    wall: float
+    rtf: float
+    windows: list[float]
+
+
+def eight_clients_come_and_go_while_one_drags(capfd: pytest.CaptureFixture[str]) -> Churn:
+    """Run the churn on a fresh real-time app; assert what must hold whatever the machine's load.
+
+    No divergence or pause during the churn; the operator's tab dying mid-drag ends the drag where it
+    was and passes control on; the new operator's input counts; no traceback reaches the server log."""
     app = start_app("trep", port=0, realtime=True, verbose=False)
     s = app.session
     churners: subprocess.Popen[str] | None = None
@@ -109,12 +121,11 @@ def test_eight_clients_come_and_go_while_one_drags(
             k += 1
             time.sleep(0.02)
         wall, sim = time.perf_counter() - wall0, s.snapshot().t - sim0
-        rtf = sim / wall
+        churn = Churn(wall, sim / wall, rtfs)
         with capfd.disabled():
-            print(
-                f"\n8 clients for {wall:.1f} s: real-time factor {rtf:.3f} (windows {min(rtfs):.3f}..{max(rtfs):.3f})"
-            )
-        assert rtf >= MIN_RTF and np.median(rtfs) >= MIN_RTF
+            print(f"\n8 clients for {wall:.1f} s: real-time factor {churn.rtf:.3f}", end="")
+            print(f" (windows {min(rtfs):.3f}..{max(rtfs):.3f})" if rtfs else "")
+        assert sim > 0.0
 
         # The operator's tab dies mid-drag: the drag ends where it was, the watcher gets control.
         dragger.drag(TARGET_HANDLE, (ee[0] + 0.03, ee[1] - 0.02, ee[2]))
@@ -139,5 +150,19 @@ def test_eight_clients_come_and_go_while_one_drags(
         app.stop()
     out, err = capfd.readouterr()
     assert "Traceback" not in out + err, err[-3000:]
+    return churn
+
+
+def test_eight_clients_come_and_go_while_one_drags(
+    capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level(logging.WARNING)
+    eight_clients_come_and_go_while_one_drags(capfd)
     bad = [r for r in caplog.records if r.levelno >= logging.ERROR]
     assert not bad, [r.getMessage() for r in bad]
+
+
+@pytest.mark.perf
+def test_eight_clients_keep_real_time(capfd: pytest.CaptureFixture[str]) -> None:
+    churn = eight_clients_come_and_go_while_one_drags(capfd)
+    assert churn.rtf >= MIN_RTF and np.median(churn.windows) >= MIN_RTF

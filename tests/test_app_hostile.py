@@ -139,7 +139,7 @@ def test_hostile_values_to_every_control(
 def test_afterwards_the_app_is_alive(hostile_app: tuple[RnsApp, ProtocolClient, ProtocolClient]) -> None:
     app, _, _ = hostile_app
     s = app.session
-    assert app._thread.is_alive() and s.state.background.worker._thread.is_alive()
+    assert app.render_thread.is_alive() and s.state.background.worker._thread.is_alive()
     late = ProtocolClient(app.port)
     try:
         wait_for_clients(app, 3, "a new client to connect")

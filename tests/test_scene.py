@@ -166,8 +166,9 @@ def test_beam_shape_and_spring_geometry() -> None:
     assert np.allclose(pts[0], 0) and np.allclose(pts[-1], [1, 0, 0]) and np.isclose(np.abs(pts[:, 1]).max(), 0.1)
 
 
+@pytest.mark.perf
 def test_update_is_cheap(trep_scene: FsmsScene, trep: FsmsModel) -> None:
-    """DESIGN: 60 Hz leaves 16 ms a frame; the scene's share should stay near 1 ms (bound loose for CI)."""
+    """60 Hz leaves 16 ms a frame; the scene's share should stay near 1 ms (bound loose for CI)."""
     q = trep.q(trep.spec.default_configuration)
     times = []
     for k in range(300):

@@ -30,7 +30,7 @@ class ZeroTorque:
 
 
 def cubic_response(H_b: float, k: float, d: float, g_b: float, G_m: float, x0: float, t: np.ndarray) -> np.ndarray:
-    """x_b(t) of H_b s^3 + (H_b (G_m + g_b) + d) s^2 + (k + d G_m) s + k G_m = 0 (DESIGN.md section 4).
+    """x_b(t) of H_b s^3 + (H_b (G_m + g_b) + d) s^2 + (k + d G_m) s + k G_m = 0 (docs/physics-notes.md).
 
     State (x, x', L): H_b x'' = -k x - d x' - L',  L' = H_b g_b x' - G_m L  (L = H_bm theta').
     """

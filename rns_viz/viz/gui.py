@@ -23,6 +23,7 @@ SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
 PLANAR3R_PRESETS = ("fig3", "fig4")
 KICK_RANGE = {"trep": 5.0, "planar3r": 50.0}  # N, slider half range
+KICK_PEAK = {"trep": 0.8, "planar3r": 5.0}  # N, the slider's initial value
 EXAGGERATION = {"trep": 10.0, "planar3r": 20.0}  # default drawn deflection factor
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
@@ -123,7 +124,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             min=-KICK_RANGE[model],
             max=KICK_RANGE[model],
             step=0.1,
-            initial_value=0.8 if model == "trep" else 5.0,
+            initial_value=KICK_PEAK[model],
             hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R).",
         )
         suppression = gui.add_checkbox(

@@ -1,8 +1,9 @@
-"""Checks of raw GUI values before they reach the session: type, finiteness, range, options.
+"""Widget conformity of raw GUI values: a value the control itself could hold (type, range, options).
 
 viser casts a client's value with ``type(current)(new)`` before our callbacks run, so NaN, +-inf
 and out-of-range numbers still arrive here; anything else odd (a server-side assignment of the
-wrong type) too. :func:`check_value` raises ``ValueError`` with a message for the user.
+wrong type) too. :func:`check_value` raises ``ValueError`` with a message for the user. What a
+value means (a stable gain, a reachable target) is the session's to check, not this module's.
 """
 
 from __future__ import annotations

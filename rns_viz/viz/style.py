@@ -11,6 +11,7 @@ from typing import Literal
 
 import numpy as np
 
+from rns_viz.live.readouts import arm_reach
 from rns_viz.model import FsmsModel
 
 Vec3 = tuple[float, float, float]
@@ -60,13 +61,6 @@ class SceneStyle:
     trail_jump: float = np.inf  # m; a longer jump of the end effector starts a new trail
     path_points: int = 240  # at most this many points per drawn path
     up: Literal["+z"] = "+z"
-
-
-def arm_reach(model: FsmsModel) -> float:
-    """Sum of the arm's joint-to-joint distances and the end-effector offset, m."""
-    pm = model.pin_model
-    links = sum(float(np.linalg.norm(pm.jointPlacements[j].translation)) for j in range(model.m + 2, pm.njoints))
-    return links + float(np.linalg.norm(pm.frames[model.ee_frame_id].placement.translation))
 
 
 def style_for(model: FsmsModel) -> SceneStyle:

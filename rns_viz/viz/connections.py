@@ -1,0 +1,88 @@
+"""Who is connected and who may operate: the operator lock, the password modal and notifications.
+
+Every browser sees the same simulation; the :class:`~rns_viz.live.operator_lock.OperatorLock`
+decides whose inputs count. The server itself (client ``None``) may always operate.
+"""
+
+from __future__ import annotations
+
+from contextlib import suppress
+
+import viser
+
+from rns_viz.live.operator_lock import OperatorLock
+from rns_viz.viz.operator_panel import OperatorPanels
+
+NOTICE_COLOURS = {"info": "blue", "warning": "yellow", "error": "red"}
+NOTICE_SECONDS = 8.0  # a notification closes itself after this long
+
+
+class Connections:
+    """The clients of one server: notifications, operator rights and the per-client panels."""
+
+    def __init__(self, server: viser.ViserServer, password: str | None) -> None:
+        self.server = server
+        self.password = password
+        self.lock = OperatorLock(password)
+        self.panels = OperatorPanels(self.lock, self.notify)
+
+    def recipients(self, client: viser.ClientHandle | None) -> list[viser.ClientHandle]:
+        """``client`` itself, or every connected client for the server's own input (None)."""
+        return [client] if client is not None else list(self.server.get_clients().values())
+
+    def notify(self, client: viser.ClientHandle | None, title: str, body: str, level: str) -> None:
+        """Show a notification to ``client``, or to every client when it is None."""
+        for c in self.recipients(client):
+            with suppress(Exception):  # the client may have gone
+                c.add_notification(title, body, color=NOTICE_COLOURS.get(level), auto_close_seconds=NOTICE_SECONDS)
+
+    def notify_by_id(self, client_id: int | None, title: str, body: str, level: str) -> None:
+        """Like :meth:`notify`, by client id; nothing if that client has left."""
+        client = None
+        if client_id is not None:
+            client = self.server.get_clients().get(client_id)
+            if client is None:
+                return
+        self.notify(client, title, body, level)
+
+    def allowed(self, client: viser.ClientHandle | None) -> bool:
+        """The server itself (client None) and the operator may operate; everyone else watches."""
+        return client is None or self.lock.is_operator(client.client_id)
+
+    def refuse_watcher(self, client: viser.ClientHandle | None) -> None:
+        """Tell a watcher why their input was not applied."""
+        if client is None:
+            return
+        body = f"{self.lock.status(client.client_id)}. Press 'Take control' to operate."
+        if self.password is not None:
+            body += " Taking control needs the session password."
+        self.notify(client, "View only", body, "warning")
+
+    def client_count(self) -> int:
+        return len(self.server.get_clients())
+
+    def client_joined(self, client: viser.ClientHandle) -> None:
+        """Give the newcomer its operator panel, and the password modal if the session has one."""
+        self.panels.add(client)
+        if self.password is None:
+            return
+        with client.gui.add_modal("rns_viz: password") as modal:
+            client.gui.add_markdown("Enter the password to operate this session; without it you can only watch.")
+            text = client.gui.add_text("Password", "")
+            enter = client.gui.add_button("Enter")
+            watch = client.gui.add_button("Watch only")
+
+        @enter.on_click
+        def _(_: viser.GuiEvent) -> None:
+            if self.lock.authenticate(client.client_id, text.value):
+                modal.close()
+            else:
+                client.add_notification("Wrong password", "Try again, or watch only.", color="red")
+
+        @watch.on_click
+        def _(_: viser.GuiEvent) -> None:
+            modal.close()
+
+    def client_left(self, client_id: int) -> None:
+        """Forget a client; the lock passes control on if it was operating."""
+        self.panels.remove(client_id)

@@ -1,0 +1,308 @@
+"""The render thread: what the session publishes, sent to the browsers (only what changed).
+
+At 60 Hz (33 Hz with a crowd) it reads the session's snapshot and updates the scene when the drawn
+state changed, the overlays when the background worker produced new ones, the notifications, the
+live plots (15 Hz), the status text and readouts (5 Hz) and the settings shown in the panel.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+import traceback
+
+import numpy as np
+import viser
+
+from rns_viz.live.laws import LAW_LABELS
+from rns_viz.live.readouts import arm_reach
+from rns_viz.live.records import Snapshot
+from rns_viz.live.session import Session
+from rns_viz.model import FsmsModel
+from rns_viz.viz.connections import Connections
+from rns_viz.viz.gui import (
+    EXAGGERATION,
+    KICK_PEAK,
+    KICK_RANGE,
+    MODEL_LABELS,
+    SPEED_LABELS,
+    GuiElements,
+    preset_description,
+)
+from rns_viz.viz.inputs import Controls
+from rns_viz.viz.panel_text import readouts_html, status_html
+from rns_viz.viz.scene import FsmsScene
+
+FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
+CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
+CROWDED_FRAME_S = 1.0 / 33.0
+PLOT_S = 1.0 / 15.0  # live plots at 15 Hz (13 Hz when crowded)
+TEXT_S = 0.2  # status line and readouts at 5 Hz
+TARGET_HANDLE = "/base/target_handle"
+REACTION_LABEL = "arm reaction"
+
+
+class Renderer:
+    """The scene of the session's model, the target handle, and the loop that keeps both current."""
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        session: Session,
+        gui: GuiElements,
+        controls: Controls,
+        connections: Connections,
+    ) -> None:
+        self.server = server
+        self.session = session
+        self.gui = gui
+        self.controls = controls
+        self.connections = connections
+        self.scene_updates = 0  # frames in which the scene was sent
+        self.plot_updates = 0
+        snap = session.snapshot()
+        self.model_name = snap.settings.model
+        self._build_scene(snap)
+        self._seen = _Seen()
+        self.sync_settings(snap)
+        self._stop = threading.Event()
+        self.thread = threading.Thread(target=self._loop, name="rns-render", daemon=True)
+
+    def start(self) -> None:
+        self.thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self.thread.is_alive():
+            self.thread.join(timeout=5.0)
+
+    # ---------------------------------------------------------------- scene
+    def _build_scene(self, snap: Snapshot) -> None:
+        self.model = FsmsModel.from_name(snap.settings.model)  # drawing only (its own pinocchio data)
+        self.scene = FsmsScene(self.server, self.model, trail_frame="base")
+        self._reach = arm_reach(self.model)
+        st = self.scene.style
+        self.handle = self.server.scene.add_transform_controls(
+            TARGET_HANDLE,
+            scale=10.0 * st.marker_radius,
+            active_axes=(True, True, False),
+            disable_rotations=True,
+            depth_test=False,
+            position=self._home(snap) + np.array([0.0, 0.0, st.overlay_z]),
+        )
+        self.handle.on_update(self.controls.on_drag)
+        self.server.scene.add_label(
+            f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
+        )
+        self.scene.set_target(snap.target)
+
+    def _home(self, snap: Snapshot) -> np.ndarray:
+        """Where the target handle rests: the session's target, else the end effector."""
+        if snap.target is not None:
+            return np.asarray(snap.target, dtype=float)
+        return self.model.ee_position(snap.q[self.model.m :])
+
+    def _rebuild_for_model(self, snap: Snapshot) -> None:
+        self.server.scene.reset()
+        self.model_name = snap.settings.model
+        self._build_scene(snap)
+        g, controls = self.gui, self.controls
+        with controls.quiet():
+            g.kick_peak.min, g.kick_peak.max = -KICK_RANGE[self.model_name], KICK_RANGE[self.model_name]
+        controls.show(g.kick_peak, KICK_PEAK[self.model_name])
+        controls.show(g.exaggeration, EXAGGERATION[self.model_name])
+        self._seen = _Seen()
+        self.sync_settings(snap)
+
+    # ---------------------------------------------------------------- the loop
+    def _loop(self) -> None:
+        next_time = time.perf_counter()
+        while not self._stop.is_set():
+            try:
+                self._frame(next_time)
+                self.connections.panels.refresh()
+            except Exception:  # drawing must never kill the app
+                traceback.print_exc()
+            next_time += CROWDED_FRAME_S if self.connections.client_count() >= CROWD else FRAME_S
+            delay = next_time - time.perf_counter()
+            if delay < -0.1:
+                next_time = time.perf_counter()
+            self._stop.wait(max(0.0, delay))
+
+    def _frame(self, now: float) -> None:
+        snap = self.session.snapshot()
+        if snap.settings.model != self.model_name:
+            self._rebuild_for_model(snap)
+        seen = self._seen
+        if snap.epoch != seen.epoch:
+            seen.epoch = snap.epoch
+            self.scene.clear_trail()
+        self._draw_state(snap)
+        if snap.overlay_version != seen.overlay_version:
+            seen.overlay_version = snap.overlay_version
+            self._draw_overlays()
+        if self.controls.take_handle_home_request():
+            seen.target_version = -1
+        self._draw_target(snap)
+        for notice in self.session.pop_notices():
+            self.connections.notify_by_id(notice.client, notice.title, notice.body, notice.level)
+        if self.controls.apply_reverts() or snap.settings_version != seen.settings_version:
+            seen.settings_version = snap.settings_version
+            self.sync_settings(snap)
+        if now >= seen.next_plot:
+            seen.next_plot = now + PLOT_S
+            self._update_plots(snap)
+        if now >= seen.next_text:
+            seen.next_text = now + TEXT_S
+            self._update_text(snap)
+
+    def _draw_state(self, snap: Snapshot) -> None:
+        """The arm, the base and the reaction arrow, when what a viewer sees changed."""
+        seen = self._seen
+        exaggeration = float(self.controls.good(self.gui.exaggeration))
+        q = self._drawn(snap.q, exaggeration) if np.all(np.isfinite(snap.q)) else seen.q
+        if exaggeration != seen.exaggeration:
+            label = self.server.scene.get_handle_by_name("/base/label")
+            if label is not None:
+                label.text = f"base x_b (drawn ×{exaggeration:g})"  # type: ignore[attr-defined]
+        if q is not None and (not np.array_equal(q, seen.q) or exaggeration != seen.exaggeration):
+            seen.q, seen.exaggeration = q, exaggeration
+            with self.server.atomic():
+                self.scene.update(q, exaggeration)
+                self.scene.set_reaction_force(self._drawn_force(snap.readouts.reaction), REACTION_LABEL)
+            self.scene_updates += 1
+
+    def _draw_target(self, snap: Snapshot) -> None:
+        """The handle back home when the target moved (or a drag was refused), and the target marker."""
+        seen = self._seen
+        if snap.target_version != seen.target_version:
+            seen.target_version = snap.target_version
+            home = self._home(snap)
+            if np.all(np.isfinite(home)):
+                self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
+        target = None if snap.target is None else tuple(np.round(snap.target, 6))
+        if target is not None and not np.all(np.isfinite(target)):
+            target = seen.target  # never draw a non-finite target
+        if target != seen.target:
+            seen.target = target
+            self.scene.set_target(None if target is None else np.asarray(target, dtype=float))
+
+    def _drawn(self, q: np.ndarray, exaggeration: float) -> np.ndarray:
+        """q rounded to what a viewer can see (1e-4 rad; 1e-4 of the arm's reach as drawn): an unchanged
+        picture sends nothing. A diverged state stays drawable (base clipped to +-10 m)."""
+        m = self.model.m
+        out = np.round(q, 4)
+        quantum = 1e-4 * self._reach / max(exaggeration, 1e-9)
+        out[:m] = np.clip(np.round(q[:m] / quantum) * quantum, -10.0, 10.0)
+        return out
+
+    def _drawn_force(self, f: float) -> float:
+        """The reaction force rounded to 4 % of the longest arrow (N): smaller changes are not drawn."""
+        st = self.scene.style
+        quantum = 0.04 * st.force_arrow_max / st.force_scale
+        return round(f / quantum) * quantum if np.isfinite(f) else 0.0
+
+    def _draw_overlays(self) -> None:
+        ov = self.session.overlays()
+        curves = list(ov.family or [])
+        if ov.current is not None:
+            curves.append(ov.current)
+        if curves:
+            self.scene.set_path_family(curves, len(curves) - 1 if ov.current is not None else None)
+        self.scene.set_reachable_set(ov.reach)
+
+    # ---------------------------------------------------------------- the panel
+    def _update_plots(self, snap: Snapshot) -> None:
+        version = self.session.plots.version
+        if version == self._seen.plot_version:
+            return
+        self._seen.plot_version = version
+        a = self.session.plot_arrays()
+        t = a["t"]
+        if len(t) < 2 or not np.all(np.isfinite(t)):
+            return
+        g = self.gui
+
+        def clean(x: np.ndarray) -> np.ndarray:  # no NaN or inf ever reaches a plot
+            return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
+
+        g.plot_xb.data = (t, clean(a["xb"]), clean(a["xb_shadow"]))
+        g.plot_L.data = (t, clean(a["L"]), clean(a["L_shadow"]))
+        g.plot_error.data = (t, clean(a["ee_error"]))
+        self.plot_updates += 1
+        titles = _plot_titles(snap)
+        if titles != self._seen.titles:
+            self._seen.titles = titles
+            g.plot_xb.title, g.plot_L.title = titles
+
+    def _update_text(self, snap: Snapshot) -> None:
+        g = self.gui
+        status, readouts = status_html(snap), readouts_html(snap)
+        if g.status.content != status:
+            g.status.content = status
+        if g.readouts.content != readouts:
+            g.readouts.content = readouts
+        pause_label = "Reset (diverged)" if snap.diverged else "Resume" if snap.paused else "Pause"
+        if g.pause.label != pause_label:
+            g.pause.label = pause_label
+            g.pause.icon = (
+                viser.Icon.REFRESH
+                if snap.diverged
+                else viser.Icon.PLAYER_PLAY
+                if snap.paused
+                else viser.Icon.PLAYER_PAUSE
+            )
+        cyclic_label = "Stop cyclic motion" if snap.mode.startswith("cyclic") else "Start cyclic motion"
+        if g.cyclic.label != cyclic_label:
+            g.cyclic.label = cyclic_label
+        if snap.sigma_range is not None and np.all(np.isfinite(snap.sigma_range)):
+            lo, hi = snap.sigma_range
+            if (g.sigma.min, g.sigma.max) != (round(lo, 1), round(hi, 1)):
+                g.sigma.min, g.sigma.max = round(lo, 1), round(hi, 1)
+            if snap.sigma is not None and np.isfinite(snap.sigma) and "scrub" not in snap.mode:
+                self.controls.show(g.sigma, float(np.clip(round(snap.sigma, 1), g.sigma.min, g.sigma.max)))
+
+    def sync_settings(self, snap: Snapshot) -> None:
+        """Show the settings in force (after presets, law switches, model switches, refused input)."""
+        g, st, show = self.gui, snap.settings, self.controls.show
+        show(g.law, LAW_LABELS[st.law])
+        show(g.suppression, st.suppress)
+        for name, slider in g.gains.items():
+            show(slider, float(getattr(st.gains, name)))
+        show(g.ubar_speed, st.ubar_speed)
+        show(g.target_speed, st.target_speed)
+        show(g.shadow, st.shadow)
+        show(g.speed, SPEED_LABELS[st.speed])
+        show(g.model, MODEL_LABELS[st.model])
+        g.preset_info.content = preset_description(st.preset)
+        on_path = self.model.n - len(self.model.selected) == 1
+        g.path_folder.visible = on_path
+        g.target_folder.visible = not on_path
+        task_gains = not on_path and st.law != "velocity"
+        joint_gains = on_path and st.law != "velocity"
+        g.gains["G_p"].visible = g.gains["G_d"].visible = task_gains
+        g.gains["k_p"].visible = g.gains["k_d"].visible = joint_gains
+
+
+class _Seen:
+    """What the render thread last sent, to send only changes."""
+
+    def __init__(self) -> None:
+        self.epoch = -1
+        self.q: np.ndarray | None = None
+        self.exaggeration = float("nan")
+        self.overlay_version = -1
+        self.target_version = -1
+        self.target: tuple[float, ...] | None = ()
+        self.settings_version = -1
+        self.plot_version = -1
+        self.next_plot = 0.0
+        self.next_text = 0.0
+        self.titles: tuple[str, str] = ("", "")
+
+
+def _plot_titles(snap: Snapshot) -> tuple[str, str]:
+    st = snap.settings
+    on, off = ("ON", "OFF") if st.suppress else ("OFF", "ON")
+    which = f"operated: suppression {on}" + (f", shadow: {off}" if st.shadow else "")
+    return f"Base deflection ({which})", f"Coupling momentum ({which})"
