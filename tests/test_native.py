@@ -28,7 +28,6 @@ from rns_viz.control import (
     TrackJointReference,
     VelocityLaw,
 )
-from rns_viz.live.laws import PlanarTrackEndEffector
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField, path_family
 from rns_viz.scenarios import SCENARIOS, run_scenario
@@ -111,7 +110,6 @@ def random_laws(model: FsmsModel) -> list[AccelerationLaw | VelocityLaw]:
         target = JointQuintic(ee0, ee0 + RNG.uniform(-0.3, 0.3, len(ee0)), 2.0)
         G_p, G_d, threshold = RNG.uniform(0, 400), RNG.uniform(0, 40), RNG.uniform(1e-3, 0.1)
         laws.append(AccelerationLaw(model, gains, TrackEndEffector(model, target, G_p, G_d, threshold)))
-        laws.append(AccelerationLaw(model, gains, PlanarTrackEndEffector(model, target, G_p, G_d, threshold)))
     return laws
 
 
