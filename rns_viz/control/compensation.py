@@ -33,6 +33,8 @@ from rns_viz.model import FsmsModel
 from rns_viz.profiles import quintic
 from rns_viz.rns import damped_pinv
 
+LIMIT_MARGIN = math.radians(30.0)  # rad: the limit term of the avoidance measure acts this close to a limit
+
 
 @dataclass(frozen=True)
 class TaskCircle:
@@ -147,7 +149,9 @@ class CompensatingLaw:
         return acc, inv.sigma_min, x_d
 
     def avoidance_gradient(self, q: np.ndarray, H2: np.ndarray) -> np.ndarray:
-        """grad over theta_2 of w = ln det(H2 H2^T + eps^2 E) + sum ln(distance to each limit), 1/rad.
+        """grad over theta_2 of w = ln det(H2 H2^T + eps^2 E) - sum (1 - d/delta)_+^2, 1/rad.
+
+        d: distance of a joint to each of its limits; delta = LIMIT_MARGIN, so the limits act only near them.
 
         d/dtheta_k ln det(A A^T + eps^2) = 2 sum_ij W_ij dA_ij/dtheta_k with W = (A A^T + eps^2)^-1 A;
         sum_j W_ij dA_ij/dtheta = d(M a_i)/dq row i with a_i = W_i on the compensator columns, held:
@@ -164,10 +168,9 @@ class CompensatingLaw:
             dtau_dq = pin.computeRNEADerivatives(self._pm, self._pd, q, self._zeros, a)[0]
             grad += 2.0 * dtau_dq[rows[i], self._cols]
         theta2 = q[self._cols]
-        span = np.maximum(self._upper - self._lower, 1e-9)
-        lo = np.maximum(theta2 - self._lower, 1e-3 * span)
-        hi = np.maximum(self._upper - theta2, 1e-3 * span)
-        return grad + 1.0 / lo - 1.0 / hi
+        near_lo = np.maximum(0.0, 1.0 - (theta2 - self._lower) / LIMIT_MARGIN)
+        near_hi = np.maximum(0.0, 1.0 - (self._upper - theta2) / LIMIT_MARGIN)
+        return grad + 2.0 / LIMIT_MARGIN * (near_lo - near_hi)
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
         self._t = t
