@@ -203,3 +203,17 @@ def test_mujoco_replays_the_dual_arm_run(runs: dict[str, Simulator], name: str) 
     )
     np.testing.assert_allclose(q[:-1, 0], rows[:, col["xb_1"]], atol=1e-9, rtol=0)
     assert np.abs(q[:, 0]).max() > 1e-6  # m: not comparing zeros
+
+
+def test_two_row_damped_inverse_is_the_projects() -> None:
+    """The Gram closed form used for J_1 equals rns.damped_pinv, damped or not."""
+    from rns_viz.control.compensation import _damped_inverse
+    from rns_viz.rns import damped_pinv
+
+    rng = np.random.default_rng(0)
+    nearly_singular = np.array([[1.0, 2.0], [2.0, 4.0 + 1e-4]])
+    for A in (rng.normal(size=(2, 2)), rng.normal(size=(2, 3)), nearly_singular, np.zeros((2, 2))):
+        ours, project = _damped_inverse(A, 1e-2), damped_pinv(A, 1e-2, 1e-2)
+        assert np.allclose(ours.inverse, project.inverse, rtol=1e-9, atol=1e-12)
+        assert ours.sigma_min == pytest.approx(project.sigma_min, abs=1e-10)
+        assert ours.damping == pytest.approx(project.damping, abs=1e-12)
