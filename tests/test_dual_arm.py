@@ -6,6 +6,8 @@ compensator's coupling row, and MuJoCo replaying the logged torques on the same 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -217,3 +219,31 @@ def test_two_row_damped_inverse_is_the_projects() -> None:
         assert np.allclose(ours.inverse, project.inverse, rtol=0, atol=1e-10 * np.abs(project.inverse).max())
         assert ours.sigma_min == pytest.approx(project.sigma_min, abs=1e-10)
         assert ours.damping == pytest.approx(project.damping, abs=1e-12)
+
+
+BOTH_ARMS = 'task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "c_joint2"]'
+
+
+@pytest.mark.parametrize(
+    ("arms", "message"),
+    [
+        ('task = ["joint1", "joint2"]\ncompensating = ["c_joint1"]', "every arm joint once"),
+        ('task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "joint2"]', "two arms"),
+        (
+            'task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "c_joint2"]\nee_frames = { compensating = "nope" }',
+            "nope",
+        ),
+        ('task = []\ncompensating = ["c_joint1", "c_joint2"]', "non-empty list"),
+    ],
+)
+def test_bad_arms_tables_name_the_problem(tmp_path: Path, arms: str, message: str) -> None:
+    from rns_viz.params import ASSETS_DIR, ModelFileError
+
+    text = (ASSETS_DIR / "trep2.toml").read_text()
+    text = text.replace('urdf = "trep2.urdf"', f'urdf = "{(ASSETS_DIR / "trep2.urdf").as_posix()}"')
+    head, rest = text.split("[arms]\n")
+    text = head + "[arms]\n" + arms + "\n\n[base]\n" + rest.split("[base]\n", 1)[1]
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ModelFileError, match=message):
+        FsmsModel.from_file(path)
