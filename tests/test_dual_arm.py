@@ -224,15 +224,15 @@ def test_two_row_damped_inverse_is_the_projects() -> None:
 BOTH_ARMS = 'task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "c_joint2"]'
 
 
+BOTH_ARMS = 'task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "c_joint2"]'
+
+
 @pytest.mark.parametrize(
     ("arms", "message"),
     [
         ('task = ["joint1", "joint2"]\ncompensating = ["c_joint1"]', "every arm joint once"),
         ('task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "joint2"]', "two arms"),
-        (
-            'task = ["joint1", "joint2"]\ncompensating = ["c_joint1", "c_joint2"]\nee_frames = { compensating = "nope" }',
-            "nope",
-        ),
+        (BOTH_ARMS + '\nee_frames = { compensating = "nope" }', "nope"),
         ('task = []\ncompensating = ["c_joint1", "c_joint2"]', "non-empty list"),
     ],
 )
