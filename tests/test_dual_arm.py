@@ -179,6 +179,20 @@ def test_null_space_motion_takes_the_compensator_off_its_singularity(trep2: Fsms
     assert sigma[t >= 2.5].min() >= 0.5 * sigma0
 
 
+def test_null_space_motion_leaves_a_joint_limit_without_shaking_the_base(trep2: FsmsModel) -> None:
+    """c_joint2 10 deg from its 150 deg limit, task arm holding still: P_2 u_2 moves the compensator out of
+    the 30 deg limit margin by self-motion, which the base does not feel (L stays 0)."""
+    theta0 = trep2.spec.default_configuration.copy()
+    theta0[trep2.arm_joint_names.index("c_joint2")] = np.radians(140.0)
+    law = CompensatingLaw(trep2, TREP2_GAINS, TaskSample.held(trep2.ee_position(theta0)[:2]))
+    sim = Simulator(trep2, law, q0=trep2.q(theta0))
+    sim.run(1.5)
+    c_joint2 = np.degrees(sim.log.column(f"theta_{trep2.arm_joint_names.index('c_joint2') + 1}"))
+    assert c_joint2.max() <= 140.0 + 1e-9 and c_joint2[-1] <= 120.0  # deg: out of the margin
+    assert np.abs(sim.log.column("xb_1")).max() <= 1e-6  # m, against mm for the task motions above
+    assert np.abs(ee_error(sim)).max() <= 1e-9  # m: the task arm stays put
+
+
 def test_kick_is_suppressed_through_the_compensator_alone(runs: dict[str, Simulator]) -> None:
     on, off = runs["trep2-kick-on"], runs["trep2-kick-off"]
     t = on.log.column("t")
