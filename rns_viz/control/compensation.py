@@ -9,7 +9,8 @@ theta_1 the task arm's joints and theta_2 the compensator's, and S H_bm = [S H_b
       theta_2'' = H_bm,2^+ (H_b G_b x_b' - H_bm' theta' - G_m L - H_bm,1 theta_1'') + P_2 u_2,
   L = S (H_bm,1 theta_1' + H_bm,2 theta_2') (Eq. 8), so that S H_bm theta'' + S H_bm' theta' = H_b G_b x_b'
   - G_m L: with G_b = 0 the coupling momentum stays zero (Eq. 10 with L_0 = 0) and -G_m L
-  removes any drift; G_b is vibration suppression (15) through the compensator alone.
+  removes any drift; G_b is vibration suppression (15) through the compensator alone (law (30) is
+  the integral of the same term for velocity-commanded drives; not provided here).
   P_2 = E - H_bm,2^+ H_bm,2 (Eq. 9) and u_2 climbs ln(sigma_2^2 + eps^2) + limit barriers: the
   compensator's own null space keeps it off its singularities (sigma_2 = sigma_min(S H_bm,2) = 0)
   and joint limits.
