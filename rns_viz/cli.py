@@ -239,7 +239,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "scenario",
         help="a preset: fig3, fig4, fig10-on/off, fig11-slow/fast/joint2, fig12-on/off, "
-        "boom7-kick-on/off, boom7-path, boom7-track, boom7-p2p",
+        "boom7-kick-on/off, boom7-path, boom7-track, boom7-p2p, trep2-circle-on/off, trep2-kick-on/off",
     )
     run.add_argument("--csv", required=True, help="output file")
     run.add_argument("--duration", type=_positive_float, default=None, help="seconds (default: the preset's)")

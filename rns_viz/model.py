@@ -37,8 +37,21 @@ class Terms:
     ee: np.ndarray  # (3,) end-effector position in the base frame, m
 
 
+@dataclass(frozen=True)
+class ArmBranch:
+    """One arm of a tree: its joints' indices into theta (pinocchio's order) and its end-effector frame."""
+
+    joints: tuple[str, ...]
+    index: np.ndarray  # (k,) positions in theta, in the order of ``joints``
+    frame: str
+
+
 class FsmsModel:
-    """A serial arm on an m-DOF elastic base (1 <= m <= 6), built from URDF + parameter file."""
+    """Arms on an m-DOF elastic base (1 <= m <= 6), built from URDF + parameter file.
+
+    One serial arm, or (with ``[arms]`` in the parameter file) a task arm and compensating arms
+    branching from the base: then ``arm_groups`` holds each arm's indices into theta.
+    """
 
     def __init__(self, spec: ModelSpec) -> None:
         self.spec = spec
@@ -68,6 +81,7 @@ class FsmsModel:
         self.ee_frame_id = model.getFrameId(spec.ee_frame)
         self.base_joint_id = self.m  # pinocchio joint index of the last base joint
         self.arm_joint_names: tuple[str, ...] = tuple(names[self.m :])
+        self.arm_groups = _arm_branches(spec, self.arm_joint_names, model)
         self.selected = np.flatnonzero(spec.base.selection)
         self.task_rows = np.array([_AXIS_INDEX[a] for a in spec.task_axes])
         self.lower = model.lowerPositionLimit[self.m :].copy()
@@ -189,6 +203,16 @@ class FsmsModel:
         points.append(self.data.oMf[self.ee_frame_id].translation)
         return (np.array(points) - base.translation) @ base.rotation
 
+    def branch_points(self, theta: np.ndarray, arm: str) -> np.ndarray:
+        """Base-frame positions (k + 1, 3) of one arm's joints and its end-effector frame, m (a tree's polyline)."""
+        branch = self.arm_groups[arm]
+        pin.framesForwardKinematics(self.pin_model, self.data, self.q(theta))
+        ids = [self.pin_model.getJointId(j) for j in branch.joints]
+        points = [self.data.oMi[i].translation for i in ids]
+        points.append(self.data.oMf[self.pin_model.getFrameId(branch.frame)].translation)
+        base = self.data.oMi[self.base_joint_id]
+        return (np.array(points) - base.translation) @ base.rotation
+
     def ee_positions(self, thetas: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """End-effector positions (K, 3) in the base frame for K configurations (K, n), x_b = 0, m.
 
@@ -233,6 +257,29 @@ class FsmsModel:
                 axis = list(self.pin_model.joints[i].extract().axis)
             axes.append(axis)
         return np.array(axes, dtype=float)
+
+
+def _arm_branches(spec: ModelSpec, arm_joints: tuple[str, ...], model: pin.Model) -> dict[str, ArmBranch]:
+    """``[arms]`` by name -> indices into theta: pinocchio orders a tree's branches its own way."""
+    arms = spec.arms
+    if arms is None:
+        return {}
+    groups = {"task": arms.task}
+    for k, joints in enumerate(arms.compensating):
+        groups["compensating" if k == 0 else f"compensating_{k + 1}"] = joints
+    listed = [j for joints in groups.values() for j in joints]
+    if sorted(listed) != sorted(arm_joints):
+        raise ModelFileError(
+            f"{spec.param_path}: [arms] must list every arm joint once, {sorted(arm_joints)}; got {sorted(listed)}"
+        )
+    branches = {}
+    for name, joints in groups.items():
+        frame = arms.ee_frames.get(name, spec.ee_frame if name == "task" else "")
+        if not model.existFrame(frame):
+            raise ModelFileError(f"{spec.urdf_path}: no frame {frame!r} for [arms] ee_frames.{name}")
+        index = np.array([arm_joints.index(j) for j in joints])
+        branches[name] = ArmBranch(tuple(joints), index, frame)
+    return branches
 
 
 def check_urdf(path: Path) -> None:

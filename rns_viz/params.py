@@ -3,7 +3,8 @@
 The URDF holds geometry and mass (the single source for dynamics and drawing); the parameter
 file holds what a URDF cannot say: which joints are the elastic base coordinates x_b, their
 stiffness K_b and damping D_b, the selection S of the selective RNS (Sec. III-B), arm joint
-damping D_m, the task axes of the end-effector Jacobian and the default configuration.
+damping D_m, the task axes of the end-effector Jacobian and the default configuration, and for
+arms branching from the base (``[arms]``) which joints form the task arm and the compensating arms.
 
 Units are SI: K_b in N/m (prismatic base coordinate) or N m/rad (revolute), D_b in N s/m or
 N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends in ``_deg``.
@@ -21,7 +22,7 @@ import numpy as np
 
 ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
 MODEL_NAMES = ("trep", "planar3r")  # the models the live app serves
-BUNDLED_MODELS = (*MODEL_NAMES, "boom7")  # every model in assets/, for FsmsModel.from_name
+BUNDLED_MODELS = (*MODEL_NAMES, "boom7", "trep2")  # every model in assets/, for FsmsModel.from_name
 TASK_AXES = ("x", "y", "z")
 
 
@@ -44,6 +45,18 @@ class BaseSpec:
 
 
 @dataclass(frozen=True)
+class ArmGroups:
+    """Arms branching from the base (a tree): the task arm's joints, each compensating arm's, frames.
+
+    Sec. III-B's dynamic redundancy: compensating arms only cancel the task arm's reaction.
+    """
+
+    task: tuple[str, ...]
+    compensating: tuple[tuple[str, ...], ...]  # one tuple of joint names per compensating arm
+    ee_frames: dict[str, str]  # "task", "compensating" (or "compensating_2", ...): frame names
+
+
+@dataclass(frozen=True)
 class ModelSpec:
     """Everything needed to build an FSMS model besides the URDF itself."""
 
@@ -56,6 +69,7 @@ class ModelSpec:
     gravity: np.ndarray  # m/s^2, world frame
     base: BaseSpec
     joint_damping: np.ndarray  # D_m diagonal, N m s/rad
+    arms: ArmGroups | None = None  # [arms]: None for a single serial arm
 
     def with_selection(self, selection: Sequence[int | bool]) -> ModelSpec:
         """The same system with another selection S (Sec. III-B): 0/1 flags over the m base coordinates."""
@@ -142,7 +156,33 @@ def load_spec(param_path: str | Path) -> ModelSpec:
         gravity=gravity,
         base=BaseSpec(tuple(joints), stiffness, damping, selection.astype(bool)),
         joint_damping=joint_damping,
+        arms=_arm_groups(data.get("arms"), path),
     )
+
+
+def _names(value: object, element: str, path: Path) -> tuple[str, ...]:
+    if not (isinstance(value, list) and value and all(isinstance(v, str) for v in value)):
+        raise ModelFileError(f"{path}: {element} must be a non-empty list of joint names")
+    return tuple(value)
+
+
+def _arm_groups(table: object, path: Path) -> ArmGroups | None:
+    """[arms]: task = [...], compensating = [...] (or a list of such lists), ee_frames = {...}."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ModelFileError(f"{path}: [arms] must be a table")
+    task = _names(_get(table, "task", "arms", path), "[arms] task", path)
+    raw = _get(table, "compensating", "arms", path)
+    groups = raw if isinstance(raw, list) and raw and all(isinstance(g, list) for g in raw) else [raw]
+    compensating = tuple(_names(g, "[arms] compensating", path) for g in groups)
+    every = [*task, *(j for g in compensating for j in g)]
+    if len(set(every)) != len(every):
+        raise ModelFileError(f"{path}: [arms] a joint belongs to two arms")
+    frames = table.get("ee_frames", {})
+    if not isinstance(frames, dict) or not all(isinstance(v, str) for v in frames.values()):
+        raise ModelFileError(f"{path}: [arms] ee_frames must map arm names to frame names")
+    return ArmGroups(task, compensating, dict(frames))
 
 
 def natural_frequency_hz(stiffness: float, mass: float) -> float:

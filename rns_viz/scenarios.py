@@ -1,9 +1,11 @@
-"""The paper's experiments as named presets (Sec. VI, Figs. 3-4; Sec. VII-D, Figs. 10-12), and the
-same ideas on the spatial model boom7 (m = 6, n = 7; Secs. II-V in general form).
+"""The paper's experiments as named presets (Sec. VI, Figs. 3-4; Sec. VII-D, Figs. 10-12), the
+same ideas on the spatial model boom7 (m = 6, n = 7; Secs. II-V in general form), and dynamic
+redundancy on trep2 (Sec. III-B: a compensating second arm).
 
 Each preset builds a ready :class:`Simulator` with the paper's parameters. Choices the paper
 leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS,
-apart from SCENARIOS, until the live app serves that model; ``run_scenario`` runs both.
+apart from SCENARIOS, until the live app serves that model, and so are trep2's in DUAL_SCENARIOS;
+``run_scenario`` runs all of them.
 """
 
 from __future__ import annotations
@@ -21,10 +23,12 @@ from rns_viz.control import (
     JointQuintic,
     PathReference,
     TaskQuintic,
+    TaskSample,
     TrackEndEffector,
     TrackJointReference,
     VelocityLaw,
 )
+from rns_viz.control.compensation import CompensatingLaw, TaskCircle
 from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.reference import path_integral_to
 from rns_viz.defaults import defaults_for
@@ -258,7 +262,52 @@ SPATIAL_SCENARIOS: dict[str, Scenario] = {
         Scenario("boom7-p2p", "boom7", 3.0, "boom7: same end points, joint-space quintic", boom7_point_to_point),
     )
 }
-ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS}
+
+# -- trep2: TREP with a compensating second arm (assets/trep2.toml) --------------------------------
+# The task arm draws one circle of 40 mm radius, its angle quintic over 4 s from 0.2 s, starting at
+# the default end-effector position (arm at (45, 90) deg); the compensator cancels its reaction
+# (G_m = 2 /s on the coupling momentum L), or is held (k_p, k_d of the joint servo).
+TREP2_GAINS = Gains(g_b=10.0, g_m=2.0)  # (15)'s TREP defaults (rns_viz.defaults), here through the compensator
+TREP2_CIRCLE = dict(radius=0.04, duration=4.0, t0=0.2)  # m, s, s
+TREP2_KICK_AT_S = 0.5
+
+
+def trep2_circle(compensate: bool) -> Simulator:
+    """Task arm on a circle; the compensator cancels the reaction (L = 0) or is held still."""
+    model = FsmsModel.from_name("trep2")
+    start = model.ee_position(model.spec.default_configuration)[:2]
+    radius = TREP2_CIRCLE["radius"]
+    circle = TaskCircle(start - np.array([radius, 0.0]), **TREP2_CIRCLE)
+    law = CompensatingLaw(model, TREP2_GAINS, circle, compensate=compensate, suppress=False)
+    return Simulator(model, law)
+
+
+def trep2_kick(suppress: bool) -> Simulator:
+    """TREP's kick with the task arm holding its end effector: (15)'s g_b acts through the compensator alone."""
+    model = FsmsModel.from_name("trep2")
+    target = TaskSample.held(model.ee_position(model.spec.default_configuration)[:2])
+    law = CompensatingLaw(model, TREP2_GAINS, target, suppress=suppress)
+    return Simulator(model, law, force=_trep_kick(TREP2_KICK_AT_S))
+
+
+DUAL_SCENARIOS: dict[str, Scenario] = {
+    s.name: s
+    for s in (
+        Scenario(
+            "trep2-circle-on", "trep2", 4.6, "trep2: task arm circle, compensator cancels", lambda: trep2_circle(True)
+        ),
+        Scenario(
+            "trep2-circle-off", "trep2", 4.6, "trep2: task arm circle, compensator held", lambda: trep2_circle(False)
+        ),
+        Scenario(
+            "trep2-kick-on", "trep2", 6.0, "trep2: kick, g_b=10 through the compensator", lambda: trep2_kick(True)
+        ),
+        Scenario(
+            "trep2-kick-off", "trep2", 6.0, "trep2: kick, compensator keeps L = 0 only", lambda: trep2_kick(False)
+        ),
+    )
+}
+ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:
