@@ -37,7 +37,8 @@ from rns_viz.sim.disturbance import StageForces
 Ref = np.ndarray | None  # theta_ref, or ee_ref (the target x_d) for Eq. (24)
 LawArgs = tuple[Callable[..., float | tuple[float, float]], tuple, Ref]
 
-# The registry: exact type -> what the C++ step computes for it. Only these exact types run natively.
+# The registry: exact type -> what the C++ step computes for it. Only these exact types run natively;
+# a subclass (which may change the arithmetic) runs its Python body unless it is added here.
 NATIVE_LAWS: dict[type, str] = {AccelerationLaw: "composite", VelocityLaw: "velocity"}
 NATIVE_NULL_INPUTS: dict[type, str] = {DampNullMotion: "damp", TrackJointReference: "joint", TrackEndEffector: "task"}
 
@@ -52,7 +53,8 @@ def unavailable_reason() -> str | None:
 
 
 def native_kind(law: object) -> str | None:
-    """ "velocity", "damp", "joint" or "task": what the C++ step computes for this law; None: Python only."""
+    """What the C++ step computes for this law ("velocity", "damp", "joint" or "task"), looked up by
+    exact type; None: the law runs in Python."""
     kind = NATIVE_LAWS.get(type(law))
     if kind == "composite":
         return NATIVE_NULL_INPUTS.get(type(law.null_input))  # type: ignore[attr-defined]
