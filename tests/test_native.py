@@ -320,3 +320,13 @@ def test_centre_of_mass_kernels_agree(name: str, monkeypatch: pytest.MonkeyPatch
         assert [p.end for p in native_family] == [p.end for p in python_family]
         for a, b in zip(native_family, python_family, strict=True):
             assert a.theta.shape == b.theta.shape and np.allclose(a.theta, b.theta, rtol=0, atol=1e-12)
+
+
+def test_a_cpp_model_that_differs_is_refused() -> None:
+    """A model changed in Python after it was read (here its gravity) is not what the C++ side
+    builds from the URDF: the native step refuses it, says so once, and the Python step runs."""
+    model = FsmsModel.from_name("trep")
+    model.pin_model.gravity.linear[:] = [0.0, -9.81, 0.0]  # changed in Python only
+    with pytest.warns(RuntimeWarning, match="differs from pinocchio's Python model"):
+        assert _native.robot_model(model) is None
+    assert not Simulator(model, AccelerationLaw(model, Gains(g_b=20.0, g_m=5.0))).native

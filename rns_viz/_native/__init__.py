@@ -23,6 +23,7 @@ from rns_viz.model import FsmsModel
 API_VERSION = 2  # the calls rns_viz.sim.native makes; rns_viz_native.API_VERSION must equal it
 INSTALL_HINT = "pip install ./native from the rns_viz repository"
 MODEL_TOLERANCE = 1e-12  # relative: the C++ model must give pinocchio's Python numbers
+NOT_INSTALLED = f"rns_viz_native is not installed (optional: {INSTALL_HINT})"
 
 
 def _load() -> tuple[ModuleType | None, str | None]:
@@ -30,7 +31,7 @@ def _load() -> tuple[ModuleType | None, str | None]:
         import rns_viz_native as module
     except ModuleNotFoundError as exc:
         if exc.name == "rns_viz_native":  # the default install: not an error, nothing to warn about
-            return None, f"rns_viz_native is not installed (optional: {INSTALL_HINT})"
+            return None, NOT_INSTALLED
         return None, f"rns_viz_native did not import ({exc})"
     except Exception as exc:  # ImportError from a missing library or a pinocchio version mismatch
         return None, f"rns_viz_native did not import ({exc})"
@@ -47,7 +48,7 @@ def _warn(reason: str) -> None:
 core: ModuleType | None
 why: str | None
 core, why = _load()
-if core is None and why is not None and "not installed" not in why:
+if core is None and why is not None and why != NOT_INSTALLED:
     _warn(why)
 
 _robots: weakref.WeakKeyDictionary[FsmsModel, Any] = weakref.WeakKeyDictionary()
@@ -61,8 +62,11 @@ def robot_model(model: FsmsModel) -> Any | None:
         return None
     robot = _robots.get(model)
     if robot is None:
-        robot = core.RobotModel(model.spec.urdf_path.read_text(), np.asarray(model.spec.gravity, dtype=float))
-        mismatch = model_mismatch(model, robot)
+        try:
+            robot = core.RobotModel(model.spec.urdf_path.read_text(), np.asarray(model.spec.gravity, dtype=float))
+            mismatch = model_mismatch(model, robot)
+        except Exception as exc:  # pinocchio's C++ parser refused what its Python side read
+            mismatch = f"it was not built: {exc}"
         if mismatch is not None:
             if str(model.spec.urdf_path) not in _refused:
                 _refused.add(str(model.spec.urdf_path))
