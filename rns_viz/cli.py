@@ -113,10 +113,11 @@ def cmd_info(args: argparse.Namespace) -> None:
         "arm_mass_kg": model.arm_mass,
         "H_bm_at_default": terms.H_bm.tolist(),
         "ee_at_default_m": terms.ee.tolist(),
-        "native_step": native_step.available(),  # laws (15)/(30) + RK4 in C++ (rns_viz.sim.native)
+        # laws (15)/(30) + RK4 in C++: the optional rns-viz-native (pip install ./native)
+        "native_step": native_step.available(),
     }
     if not native_step.available():
-        info["native_step_unavailable"] = native_step.unavailable_reason()
+        info["native_step_unavailable"] = native_step.unavailable_reason()  # why the Python step runs
     print(json.dumps(info, indent=2))
 
 

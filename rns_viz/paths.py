@@ -39,13 +39,13 @@ class CouplingField:
     For a translating base, row i of H_bm is M_total a_i . J_com (the base momentum along axis
     a_i) and M_total a_i . r_com its potential (Eq. 26, up to a constant): one
     jacobianCenterOfMass call gives both. Other bases read H_bm from crba and have no potential.
-    With the native extension built, the K configurations of a call go to pinocchio in one C++
-    call (``native=False``: one Python call each, the same numbers).
+    With the optional native module installed, the K configurations of a call go to pinocchio in
+    one C++ call (``native=False``: one Python call each, the same numbers).
     """
 
     def __init__(self, model: FsmsModel, native: bool = True) -> None:
         self.model = model
-        self.native = _native.core if native else None
+        self.native = _native.robot_model(model) if native else None
         self.q = np.zeros(model.nv)
         self.rows = model.selected
         self.m = model.m
@@ -69,7 +69,7 @@ class CouplingField:
         com = np.empty((K, 3))
         if self.native is not None:
             flat = np.ascontiguousarray(thetas, dtype=float).reshape(-1)
-            self.native.com_jacobians(pm, m, flat, J.reshape(-1), com.reshape(-1) if want_potential else _NO_COM)
+            self.native.com_jacobians(m, flat, J.reshape(-1), com.reshape(-1) if want_potential else _NO_COM)
             H = np.einsum("ra,kan->krn", self.scaled_axes, J)
             return H, (com @ self.scaled_axes.T if want_potential else None)
         jacobian_com = pin.jacobianCenterOfMass
@@ -86,7 +86,7 @@ class CouplingField:
         pm, data, q, m = self.model.pin_model, self.model.data, self.q, self.m
         com = np.empty((len(thetas), 3))
         if self.native is not None:
-            self.native.centers_of_mass(pm, m, np.ascontiguousarray(thetas, dtype=float).reshape(-1), com.reshape(-1))
+            self.native.centers_of_mass(m, np.ascontiguousarray(thetas, dtype=float).reshape(-1), com.reshape(-1))
             return com @ self.scaled_axes.T
         for k in range(len(thetas)):
             q[m:] = thetas[k]

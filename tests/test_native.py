@@ -1,11 +1,14 @@
-"""The native closed-loop step (C++) computes what the Python laws (15), (30) and RK4 compute.
+"""The native closed-loop step (C++, ``pip install ./native``) computes what the Python laws (15),
+(30) and RK4 compute.
 
-Trajectories with a kick, suppression switching on and gains changed mid-run agree to 1e-12, and so
-do the paper's presets run both ways; the laws alone agree at random states, at the TREP
-singularity, for a 2-DOF base with one or both rows selected (the SVD branch) and with gravity (the
-Coriolis branch of H_bm' theta'). CI sets RNS_VIZ_REQUIRE_NATIVE=1: a missing extension fails there.
-Eq. (24) tracking is compared on the 3R (a 2-D RNS) and on the 2-DOF base; the path tracer's
-centre-of-mass kernels against pinocchio's Python calls.
+The C++ pinocchio model built from the URDF text gives the Python model's M and c of Eq. (1).
+Trajectories with a kick (force at the RK4 stage times), suppression switching on and gains changed
+mid-run agree to 1e-12, and so do the paper's presets run both ways; the laws alone agree at random
+states, at the TREP singularity, for a 2-DOF base with one or both rows selected (the SVD branch)
+and with gravity (the Coriolis branch of H_bm' theta'). Eq. (24) tracking is compared on the 3R (a
+2-D RNS) and on the 2-DOF base; the path tracer's centre-of-mass kernels against pinocchio's Python
+calls. Skipped when the module is not installed, unless RNS_VIZ_REQUIRE_NATIVE=1 (CI's native job):
+then a missing or unusable module fails.
 """
 
 from __future__ import annotations
@@ -15,8 +18,10 @@ import os
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
+from rns_viz import _native
 from rns_viz.control import (
     AccelerationLaw,
     DampNullMotion,
@@ -28,6 +33,8 @@ from rns_viz.control import (
     TrackJointReference,
     VelocityLaw,
 )
+from rns_viz.control.common import Coupling
+from rns_viz.control.null_input import NullOutput
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField, path_family
 from rns_viz.scenarios import SCENARIOS, run_scenario
@@ -39,6 +46,7 @@ if not native.available():
     pytest.skip(f"native step not built: {native.unavailable_reason()}", allow_module_level=True)
 
 RNG = np.random.default_rng(11)
+NATIVE_LAW_TOLERANCE = 1e-12  # relative, per logged column and state entry
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 
 
@@ -111,6 +119,32 @@ def random_laws(model: FsmsModel) -> list[AccelerationLaw | VelocityLaw]:
         G_p, G_d, threshold = RNG.uniform(0, 400), RNG.uniform(0, 40), RNG.uniform(1e-3, 0.1)
         laws.append(AccelerationLaw(model, gains, TrackEndEffector(model, target, G_p, G_d, threshold)))
     return laws
+
+
+def models(tmp_path: Path) -> list[FsmsModel]:
+    """The bundled models and the 2-DOF base with gravity (every branch of the C++ model build)."""
+    return [FsmsModel.from_name("trep"), FsmsModel.from_name("planar3r"), xy_model(tmp_path, [1, 1], [0.0, -9.81, 0.0])]
+
+
+def test_cpp_model_equals_the_python_model(tmp_path: Path) -> None:
+    """crba and nonLinearEffects of the model built in C++ from the URDF text equal pinocchio's
+    Python model (same parser, same gravity) to 1e-12, at random states."""
+    for model in models(tmp_path):
+        robot = _native.robot_model(model)
+        assert robot is not None and robot.nv == model.nv
+        data = model.pin_model.createData()
+        worst = 0.0
+        for _ in range(50):
+            q = np.r_[RNG.normal(0, 1e-2, model.m), RNG.uniform(-math.pi, math.pi, model.n)]
+            v = RNG.normal(0, 1.0, model.nv)
+            M, c = model.mass_matrix(q), pin.nonLinearEffects(model.pin_model, data, q, v)
+            assert np.any(c != 0.0)
+            worst = max(
+                worst,
+                float(np.max(np.abs(robot.mass_matrix(q) - M))) / max(1.0, float(np.max(np.abs(M)))),
+                float(np.max(np.abs(robot.nonlinear_effects(q, v) - c))) / max(1.0, float(np.max(np.abs(c)))),
+            )
+        assert worst <= NATIVE_LAW_TOLERANCE, (model.name, worst)
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
@@ -192,9 +226,32 @@ def test_two_dof_base(tmp_path: Path, selection: list[int], gravity: list[float]
 
 
 class OwnArithmetic(TrackJointReference):
-    """A subclass that changes the arithmetic: not computed natively."""
+    """A subclass that changes the arithmetic: not in the registry, so computed in Python."""
 
-    native_kind = None
+    def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
+        out = super().__call__(t, cp, q, v)
+        out.Pu = 0.5 * out.Pu
+        return out
+
+
+def test_subclasses_run_their_own_python_body() -> None:
+    """Only the registry's exact types run natively: a subclass (of TrackEndEffector, or one that
+    changes the arithmetic) runs its Python body, natively simulated or not."""
+    model = FsmsModel.from_name("planar3r")
+    gains = Gains(g_b=10.0, g_m=1.0)
+    ee0 = model.ee_position(model.spec.default_configuration)[model.task_rows]
+    target = JointQuintic(ee0, ee0 + np.array([0.05, -0.05]), 1.0)
+
+    class OwnTracker(TrackEndEffector):
+        pass
+
+    for null_input in (
+        OwnTracker(model, target, 100.0, 20.0),
+        OwnArithmetic(FixedReference(model.spec.default_configuration + 0.1), 4.0, 4.0),
+    ):
+        law = AccelerationLaw(model, gains, null_input)
+        assert native.native_kind(law) is None and not Simulator(model, law).native
+    assert native.native_kind(AccelerationLaw(model, gains, TrackEndEffector(model, target, 1.0, 1.0))) == "task"
 
 
 def test_other_laws_stay_in_python() -> None:
@@ -248,13 +305,11 @@ def test_divergence_keeps_the_last_finite_state() -> None:
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
 def test_centre_of_mass_kernels_agree(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """The path tracer's batch kernels give pinocchio's numbers: the same family, the same set."""
-    import rns_viz._native
-
     model = FsmsModel.from_name(name)
     thetas = RNG.uniform(-math.pi, math.pi, (25, model.n))
     fast = CouplingField(model)
     assert fast.native is not None
-    monkeypatch.setattr(rns_viz._native, "core", None)
+    monkeypatch.setattr(_native, "core", None)
     slow = CouplingField(model)
     assert slow.native is None
     (H_fast, pot_fast), (H_slow, pot_slow) = fast.rows_at(thetas, True), slow.rows_at(thetas, True)
@@ -268,3 +323,13 @@ def test_centre_of_mass_kernels_agree(name: str, monkeypatch: pytest.MonkeyPatch
         assert [p.end for p in native_family] == [p.end for p in python_family]
         for a, b in zip(native_family, python_family, strict=True):
             assert a.theta.shape == b.theta.shape and np.allclose(a.theta, b.theta, rtol=0, atol=1e-12)
+
+
+def test_a_cpp_model_that_differs_is_refused() -> None:
+    """A model changed in Python after it was read (here its gravity) is not what the C++ side
+    builds from the URDF: the native step refuses it, says so once, and the Python step runs."""
+    model = FsmsModel.from_name("trep")
+    model.pin_model.gravity.linear[:] = [0.0, -9.81, 0.0]  # changed in Python only
+    with pytest.warns(RuntimeWarning, match="differs from pinocchio's Python model"):
+        assert _native.robot_model(model) is None
+    assert not Simulator(model, AccelerationLaw(model, Gains(g_b=20.0, g_m=5.0))).native

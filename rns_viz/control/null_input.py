@@ -1,14 +1,13 @@
 """Null-space inputs P_RNS u for the composite laws (12)/(15)/(16): what the arm does in the RNS.
 
 Each returns the joint acceleration P u (rad/s^2), which by Eq. (14) never reaches the base.
-``native_kind`` names the input the native step (rns_viz.sim.native) computes in its place; a
-subclass that changes the arithmetic must set it to None.
+Which of them the native step also computes is listed, by exact type, in rns_viz.sim.native.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -47,8 +46,6 @@ def _refuse(owner: object, sample: object) -> TypeError:
 class DampNullMotion:
     """u = -G_m theta': with the law's own -G_m (E - P) theta' this is the paper's -G_m theta' (Fig. 3)."""
 
-    native_kind: ClassVar[str | None] = "damp"
-
     g_m: float  # 1/s
 
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
@@ -64,8 +61,6 @@ class DampNullMotion:
 @dataclass
 class TrackJointReference:
     """u = theta_r'' + k_d (theta_r' - theta') + k_p (theta_r - theta), projected into the RNS."""
-
-    native_kind: ClassVar[str | None] = "joint"
 
     reference: JointReference
     k_p: float  # 1/s^2
@@ -98,8 +93,6 @@ class TrackEndEffector:
     P u = J-bar^+ [x_d'' + G_d e' + G_p e - J' theta' + J H_bm^+ H_bm' theta'],  e = x_d - x_e.
     J-bar = J P_RNS is inverted with the damped inverse; its smallest singular value is reported.
     """
-
-    native_kind: ClassVar[str | None] = "task"
 
     model: FsmsModel
     target: TaskReference

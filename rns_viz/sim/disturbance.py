@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 ForceInput = Callable[[float], "np.ndarray | None"]  # t (s) -> generalised base force (m,) or None
+# The force at the RK4 stage times t, t + dt/2, t + dt of one step (None entries: no force then).
+StageForces = tuple["np.ndarray | None", "np.ndarray | None", "np.ndarray | None"]
 
 
 @dataclass(frozen=True)
@@ -60,3 +62,12 @@ class Pulses:
     def __call__(self, t: float) -> np.ndarray | None:
         forces = [f for f in (p(t) for p in self.pulses) if f is not None]
         return np.sum(forces, axis=0) if forces else None
+
+
+def stage_forces(force: ForceInput, t: float, dt: float) -> StageForces | None:
+    """The force sampled where RK4 evaluates the plant in the step from t; None when it is zero
+    throughout (no force input, or none of the three samples in a pulse)."""
+    if isinstance(force, NoForce):
+        return None
+    samples = (force(t), force(t + 0.5 * dt), force(t + dt))
+    return None if all(f is None for f in samples) else samples

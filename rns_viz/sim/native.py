@@ -1,70 +1,93 @@
 """The native closed-loop step: a law of the paper and RK4 with the torque held, in one C++ call.
 
-``rns_viz._closed_loop`` (built from ``rns_viz/_native/closed_loop.cpp`` at install time when a C++
-compiler is there) computes, on the same pinocchio model:
+The optional distribution ``rns-viz-native`` (``pip install ./native``; see :mod:`rns_viz._native`)
+computes, on a pinocchio model it builds from the same URDF text:
 
 - :class:`~rns_viz.control.AccelerationLaw` (15) with :class:`~rns_viz.control.DampNullMotion`,
   :class:`~rns_viz.control.TrackJointReference` or :class:`~rns_viz.control.TrackEndEffector`
-  (Eq. 24) as null-space input (by its ``native_kind``);
+  (Eq. 24) as null-space input;
 - :class:`~rns_viz.control.VelocityLaw` (30) behind its velocity servo;
 
-then :meth:`~rns_viz.sim.plant.Plant.rk4_state_step`. :class:`~rns_viz.sim.Simulator` uses it for
-those laws when it is available. Gains, suppression, references and the force are read from the
-Python objects at every step, so changing them takes effect as before. Tests compare trajectories.
+then :meth:`~rns_viz.sim.plant.Plant.rk4_state_step` with the force at the stage times.
+:class:`~rns_viz.sim.Simulator` uses it for exactly these types (``NATIVE_LAWS``,
+``NATIVE_NULL_INPUTS``): a subclass may change the arithmetic, so it runs in Python unless it is
+added there. Gains, suppression, references and the force are read from the Python objects at every
+step, so changing them takes effect as before. Tests compare trajectories.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from rns_viz import _native
-from rns_viz.control import AccelerationLaw, ControlOutput, DampNullMotion, VelocityLaw
+from rns_viz.control import (
+    AccelerationLaw,
+    ControlOutput,
+    DampNullMotion,
+    TrackEndEffector,
+    TrackJointReference,
+    VelocityLaw,
+)
 from rns_viz.model import FsmsModel
-
-_closed_loop, _WHY = _native.core, _native.why
-
+from rns_viz.sim.disturbance import StageForces
 
 Ref = np.ndarray | None  # theta_ref, or ee_ref (the target x_d) for Eq. (24)
 LawArgs = tuple[Callable[..., float | tuple[float, float]], tuple, Ref]
 
+# The registry: exact type -> what the C++ step computes for it. Only these exact types run natively;
+# a subclass (which may change the arithmetic) runs its Python body unless it is added here.
+NATIVE_LAWS: dict[type, str] = {AccelerationLaw: "composite", VelocityLaw: "velocity"}
+NATIVE_NULL_INPUTS: dict[type, str] = {DampNullMotion: "damp", TrackJointReference: "joint", TrackEndEffector: "task"}
+
 
 def available() -> bool:
-    return _closed_loop is not None
+    return _native.core is not None
 
 
 def unavailable_reason() -> str | None:
     """Why the native step is not available (None when it is)."""
-    return _WHY
+    return _native.why
 
 
-NULL_KINDS = ("damp", "joint", "task")  # the null-space inputs computed natively (their native_kind)
+def native_kind(law: object) -> str | None:
+    """What the C++ step computes for this law ("velocity", "damp", "joint" or "task"), looked up by
+    exact type; None: the law runs in Python."""
+    kind = NATIVE_LAWS.get(type(law))
+    if kind == "composite":
+        return NATIVE_NULL_INPUTS.get(type(law.null_input))  # type: ignore[attr-defined]
+    return kind
 
 
 def supports(law: object) -> bool:
-    """The native step computes exactly this law (its type and its null-space input's kind)."""
-    if type(law) is VelocityLaw:
-        return True
-    return type(law) is AccelerationLaw and _null_kind(law) in NULL_KINDS
+    """The native step computes exactly this law (its exact type and its null-space input's)."""
+    return native_kind(law) is not None
 
 
-def _null_kind(law: AccelerationLaw) -> str | None:
-    return getattr(type(law.null_input), "native_kind", None)
+def step_for(model: FsmsModel, law: object) -> NativeStep | None:
+    """The native step for this law, or None: not one of the registry's types, no native module,
+    or a C++ model that does not reproduce the Python one."""
+    if not supports(law):
+        return None
+    robot = _native.robot_model(model)
+    return None if robot is None else NativeStep(model, law, robot)  # type: ignore[arg-type]
 
 
 class NativeStep:
     """``(t, x, f_ext, dt) -> (x_next, ControlOutput)`` for one supported law; ``control(t, x)`` alone."""
 
-    def __init__(self, model: FsmsModel, law: AccelerationLaw | VelocityLaw) -> None:
-        if _closed_loop is None:
-            raise RuntimeError(_WHY)
+    def __init__(self, model: FsmsModel, law: AccelerationLaw | VelocityLaw, robot: Any | None = None) -> None:
+        robot = _native.robot_model(model) if robot is None else robot
+        if robot is None:
+            raise RuntimeError(_native.why or f"the native model of {model.name} differs from the Python one")
         if not supports(law):
             raise ValueError(f"the native step does not compute {type(law).__name__}")
         coupling = law.coupling
         self.law = law
-        self._core = _closed_loop.ClosedLoop(
-            model.pin_model,
+        self._core = _native.core.ClosedLoop(  # type: ignore[union-attr]
+            robot,
             [int(i) for i in model.selected],
             np.ascontiguousarray(model.K_b, dtype=float),
             np.ascontiguousarray(model.D_b, dtype=float),
@@ -72,23 +95,27 @@ class NativeStep:
             float(coupling.threshold),
             float(coupling.max_damping),
             bool(model.cb_is_hbm_dot),
-            int(model.ee_frame_id),
+            model.spec.ee_frame,
             int(model.base_joint_id),
             [int(i) for i in model.task_rows],
         )
         self._nx, self._n, self._r = 2 * model.nv, model.n, len(model.selected)
-        self._no_force = np.zeros(model.m)
+        self._no_force = np.zeros(3 * model.m)
+        self._forces = np.empty(3 * model.m)  # f at t, t + dt/2, t + dt (the RK4 stage times)
+        self._m = model.m
         self._velocity = type(law) is VelocityLaw
         self._law_args = self._velocity_args if self._velocity else self._composite_args
         self._damped_step = self._core.damped_step
 
     def __call__(
-        self, t: float, x: np.ndarray, f_ext: np.ndarray | None, dt: float
+        self, t: float, x: np.ndarray, forces: StageForces | None, dt: float
     ) -> tuple[np.ndarray, ControlOutput] | None:
         """x_next and the control; None when the law's null-space input changed to one computed in
-        Python only; FloatingPointError (nothing kept) when the step is not finite."""
+        Python only; FloatingPointError (nothing kept) when the step is not finite.
+
+        ``forces``: the base force at t, t + dt/2 and t + dt (None: no force over the step)."""
         x_next, tau, L = np.empty(self._nx), np.empty(self._n), np.empty(self._r)
-        f = self._no_force if f_ext is None else np.ascontiguousarray(f_ext, dtype=float)
+        f = self._no_force if forces is None else self._stacked(forces)
         law = self.law
         if not self._velocity and type(law.null_input) is DampNullMotion:  # type: ignore[union-attr]
             # the common case without a reference, kept short: this runs at every step
@@ -100,6 +127,12 @@ class NativeStep:
             return None
         step, args, ref = law_args
         return x_next, self._output(step(x, *args, f, dt, x_next, tau, L), tau, L, ref)
+
+    def _stacked(self, forces: StageForces) -> np.ndarray:
+        out, m = self._forces, self._m
+        for i, f in enumerate(forces):
+            out[i * m : (i + 1) * m] = 0.0 if f is None else f
+        return out
 
     def control(self, t: float, x: np.ndarray) -> ControlOutput:
         """The law alone at (t, x): what ``law(t, q, v)`` returns, computed natively."""
@@ -120,7 +153,7 @@ class NativeStep:
     def _composite_args(self, t: float, control: bool) -> LawArgs | None:
         law, core = self.law, self._core
         g_b, g_m, null = law.suppression_gain(t), law.gains.g_m, law.null_input  # type: ignore[union-attr]
-        kind = _null_kind(law)  # type: ignore[arg-type]
+        kind = native_kind(law)
         if kind == "damp":
             return (core.damped_control if control else core.damped_step), (g_b, g_m, null.g_m), None
         if kind == "task":

@@ -10,6 +10,7 @@ import numpy as np
 import pinocchio as pin
 
 from rns_viz.model import FsmsModel
+from rns_viz.sim.disturbance import StageForces
 
 RK4_WEIGHTS = np.array([1.0, 2.0, 2.0, 1.0]) / 6.0  # b_i of the classical RK4
 
@@ -41,9 +42,12 @@ class Plant:
 
     def hold(self, tau: np.ndarray, f_ext: np.ndarray | None) -> None:
         """Set the joint torques and base force used by :meth:`held_acceleration`."""
-        m = self.model.m
-        self._tau, self._f = tau, f_ext
-        self._u[m:] = tau
+        self._tau = tau
+        self._u[self.model.m :] = tau
+        self._set_force(f_ext)
+
+    def _set_force(self, f_ext: np.ndarray | None) -> None:
+        self._f = f_ext
         if self._scalar_base:
             self._f0 = 0.0 if f_ext is None else float(f_ext[0])
 
@@ -73,18 +77,24 @@ class Plant:
         nv = self.model.nv
         return x[:nv], x[nv:]
 
-    def rk4_state_step(self, x: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None, dt: float) -> np.ndarray:
+    def rk4_state_step(
+        self, x: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | StageForces | None, dt: float
+    ) -> np.ndarray:
         """:meth:`rk4_step` on the stacked state x = (q, v); returns a new array.
 
         Stages x_{s+1} = x + c_s k_s (c = dt/2, dt/2, dt) with slopes k_s = (v_s, a_s); the step is
-        x + dt (k_1 + 2 k_2 + 2 k_3 + k_4) / 6.
+        x + dt (k_1 + 2 k_2 + 2 k_3 + k_4) / 6. ``f_ext``: one base force held over the step, or
+        its samples at the stage times (f(t), f(t + dt/2), f(t + dt)) for k_1, k_2 and k_3, k_4.
         """
-        self.hold(tau, f_ext)
+        sampled = isinstance(f_ext, tuple)
+        self.hold(tau, f_ext[0] if sampled else f_ext)  # type: ignore[index, arg-type]
         q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
         xs[0][:] = x
         for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
             a[s][:] = self.held_acceleration(q[s], v[s])
             np.add(x, c * k[s], out=xs[s + 1])
+            if sampled and s != 1:  # k_2 and k_3 at t + dt/2, k_4 at t + dt
+                self._set_force(f_ext[s // 2 + 1])  # type: ignore[index]
         a[3][:] = self.held_acceleration(q[3], v[3])
         return x + self._weights(dt).dot(self._slopes)
 

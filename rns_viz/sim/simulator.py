@@ -1,11 +1,13 @@
 """The simulation loop: a control law driving the plant, with force events and a step log.
 
 Default: RK4 at 1 ms with the torque computed once per step and held over it (a digital
-controller). ``hold_control=False`` evaluates the law at every RK4 stage (continuous time),
-used where a closed-form continuous closed loop is the oracle.
+controller), and the external force, a continuous input, sampled at the RK4 stage times t,
+t + dt/2 and t + dt. ``hold_control=False`` evaluates the law at every RK4 stage (continuous
+time), used where a closed-form continuous closed loop is the oracle. The log's ``fext`` columns
+hold the force at the row's time t (the first of the three samples).
 
-For laws (15) and (30) the whole step (law + RK4) runs in C++
-when the native extension is built (:mod:`rns_viz.sim.native`); ``native=False`` forces Python.
+For laws (15) and (30) the whole step (law + RK4) runs in C++ when the optional native module is
+installed (:mod:`rns_viz.sim.native`); ``native=False`` forces Python.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import numpy as np
 from rns_viz.control.common import ControlLaw, ControlOutput
 from rns_viz.model import FsmsModel
 from rns_viz.sim import native as native_step
-from rns_viz.sim.disturbance import ForceInput, NoForce
+from rns_viz.sim.disturbance import ForceInput, NoForce, stage_forces
 from rns_viz.sim.log import RowLayout, StepLog
 from rns_viz.sim.plant import Plant
 
@@ -74,11 +76,7 @@ class Simulator:
     @law.setter
     def law(self, law: ControlLaw) -> None:
         self._law = law
-        self._native = (
-            native_step.NativeStep(self.model, law)  # type: ignore[arg-type]
-            if self.use_native and native_step.supports(law)
-            else None
-        )
+        self._native = native_step.step_for(self.model, law) if self.use_native else None
 
     @property
     def native(self) -> bool:
@@ -126,9 +124,10 @@ class Simulator:
     def step(self) -> ControlOutput:
         """Compute the control at t, advance the state by dt, log the step; returns the control."""
         t, x, dt = self.t, self._x, self.dt
-        f = self.force(t)
+        forces = stage_forces(self.force, t, dt)  # at t, t + dt/2, t + dt
+        f = None if forces is None else forces[0]
         try:  # law and RK4 in one C++ call, which checks finiteness (None: the law is Python's)
-            stepped = self._native(t, x, f, dt) if self._native is not None else None
+            stepped = self._native(t, x, forces, dt) if self._native is not None else None
         except FloatingPointError:
             raise SimulationDiverged(_DIVERGED.format(t=t)) from None
         if stepped is not None:
@@ -139,7 +138,7 @@ class Simulator:
             if not self.hold_control:
                 x_next = np.concatenate(self._rk4_continuous(t, q, v, dt))
             elif self.integrator == "rk4":
-                x_next = self.plant.rk4_state_step(x, out.tau, f, dt)
+                x_next = self.plant.rk4_state_step(x, out.tau, forces, dt)
             else:
                 x_next = np.concatenate(self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt))
             if not (_all_finite(x_next) and _all_finite(out.tau)):
