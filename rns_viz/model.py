@@ -106,13 +106,16 @@ class FsmsModel:
         return np.concatenate([xb, np.asarray(theta, dtype=float)])
 
     # -- dynamics ------------------------------------------------------------------------------
-    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """Joint-space inertia matrix of Eq. (1), full and symmetric."""
-        return pin.crba(self.pin_model, self.data, q)
+    def mass_matrix(self, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+        """Joint-space inertia matrix of Eq. (1), full and symmetric.
 
-    def coupling_matrix(self, q: np.ndarray) -> np.ndarray:
+        ``data``: pinocchio data to work in (default: the model's own, which the laws also use).
+        """
+        return pin.crba(self.pin_model, self.data if data is None else data, q)
+
+    def coupling_matrix(self, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """S H_bm: the rows of the inertia coupling matrix selected by S (Sec. III-B)."""
-        return self.mass_matrix(q)[self.selected, self.m :]
+        return self.mass_matrix(q, data)[self.selected, self.m :]
 
     def dynamics(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, the velocity terms c = (c_b, c_m) and H_bm' theta' at (q, v): what the laws need.

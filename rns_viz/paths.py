@@ -64,7 +64,7 @@ class CouplingField:
             H = np.empty((K, len(rows), n))
             for k in range(K):
                 q[m:] = thetas[k]
-                H[k] = pin.crba(pm, data, q)[rows, m:]
+                H[k] = self.model.coupling_matrix(q)
             return H, None
         J = np.empty((K, 3, n))
         com = np.empty((K, 3))
@@ -120,10 +120,7 @@ class _NullField(CouplingField):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
         """Unit n (K, n), |n| (K,), rows S H_bm (K, r, n) and, if asked and defined, potentials (K, r)."""
         H, pot = self.rows_at(thetas, want_potential)
-        if H.shape[1:] == (1, 2):  # Eq. (27): n = (h_2, -h_1)
-            out = np.stack([H[:, 0, 1], -H[:, 0, 0]], axis=1)
-        else:
-            out = np.array([null_vector(Hk) for Hk in H])
+        out = null_vector(H)
         norm = np.sqrt(np.einsum("ij,ij->i", out, out))
         return out / np.maximum(norm, 1e-300)[:, None], norm, H, pot
 

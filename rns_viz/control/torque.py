@@ -29,7 +29,7 @@ class TorqueLaw(CompositeLaw):
         null = self.null_input(t, cp, q, v)
         c_b = cp.c[:m][self.model.selected]
         vib = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - c_b)
-        arm = null.Pu - self.gains.g_m * (cp.thetadot - cp.P @ cp.thetadot)
+        arm = null.in_rns(cp) - self.gains.g_m * (cp.thetadot - cp.project(cp.thetadot))
         tau = cp.H_m @ (vib + arm) + cp.c[m:] + self.model.D_m @ cp.thetadot
         return ControlOutput(
             tau=tau,
