@@ -15,8 +15,6 @@ from __future__ import annotations
 from dataclasses import fields, replace
 from typing import Literal
 
-import numpy as np
-
 from rns_viz.control import (
     AccelerationLaw,
     ControlLaw,
@@ -30,10 +28,7 @@ from rns_viz.control import (
     TrackJointReference,
     VelocityLaw,
 )
-from rns_viz.control.common import Coupling
-from rns_viz.control.null_input import NullOutput
 from rns_viz.control.reference import JointReference
-from rns_viz.live.dls import damped_inverse
 from rns_viz.model import FsmsModel
 
 LawKind = Literal["acceleration", "torque", "velocity"]
@@ -75,20 +70,6 @@ def checked_gains(gains: Gains, changes: dict[str, float]) -> Gains:
     return replace(gains, **changes)
 
 
-class PlanarTrackEndEffector(TrackEndEffector):
-    """Eq. (24) exactly as :class:`TrackEndEffector`, with the closed-form damped inverse for a
-    two-row J-bar (the planar task): the 3R's live law runs twice per millisecond (shadow run)."""
-
-    def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
-        J, Jdot_thetadot, ee = self.model.ee_kinematics(q, cp.thetadot)
-        x_d, xdot_d, xddot_d = self.target(t)
-        e = x_d - ee[self.model.task_rows][: len(x_d)]
-        edot = xdot_d - J @ cp.thetadot
-        inverse, sigma = damped_inverse(J @ cp.P, self.threshold)
-        rhs = xddot_d + self.G_d * edot + self.G_p * e - Jdot_thetadot + J @ (cp.H_bm_pinv @ cp.hbm_dot_thetadot)
-        return NullOutput(inverse @ rhs, sigma_jbar=sigma, ee_ref=x_d)
-
-
 def build_law(
     model: FsmsModel,
     kind: LawKind,
@@ -101,7 +82,7 @@ def build_law(
     if kind == "velocity":
         return VelocityLaw(model, gains, joint_ref, suppress=suppress, feedforward=task_ref is not None)
     if task_ref is not None:
-        null = PlanarTrackEndEffector(model, task_ref, gains.G_p, gains.G_d, threshold=TASK_THRESHOLD)  # type: ignore[arg-type]
+        null = TrackEndEffector(model, task_ref, gains.G_p, gains.G_d, threshold=TASK_THRESHOLD)  # type: ignore[arg-type]
     else:
         null = TrackJointReference(joint_ref, gains.k_p, gains.k_d)
     cls = AccelerationLaw if kind == "acceleration" else TorqueLaw
