@@ -9,8 +9,6 @@ S H_bm (-G_m theta') = -G_m L), its RNS part -G_m P theta' is the default null-s
 
 from __future__ import annotations
 
-import operator
-
 import numpy as np
 
 from rns_viz.control.common import ControlOutput, Coupling, realize_acceleration
@@ -42,23 +40,20 @@ def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) ->
 
     The input's P (u - g_u theta') = u - g_u theta' - h^+ (h u - g_u L) joins that factor:
         theta'' = h^+ (g_b H_b x_b' - h' theta' - (g_m - g_u) L - h u) + u - g_u theta'.
-    Python floats: for a few joints each numpy call costs more than its arithmetic.
     """
     H_b, xdot_b, hbm_dot_thetadot, L = cp.row_terms()
     g_u = null.damping
     y = g_b * H_b * xdot_b - hbm_dot_thetadot - (g_m - g_u) * L
-    pinv, thetadot = [p for (p,) in cp.H_bm_pinv.tolist()], cp.thetadot.tolist()
-    if null.u is None:
-        thetaddot = np.array([p * y - g_u * w for p, w in zip(pinv, thetadot, strict=True)])
-    else:
-        u = null.u.tolist()
-        y -= _dot(cp.H_bm[0].tolist(), u)
-        thetaddot = np.array([p * y - g_u * w + u_i for p, w, u_i in zip(pinv, thetadot, u, strict=True)])
-    return thetaddot if null.Pu is None else thetaddot + null.Pu
-
-
-def _dot(a: list[float], b: list[float]) -> float:
-    return sum(map(operator.mul, a, b))
+    if null.u is not None:
+        y -= cp.H_bm[0].dot(null.u)
+    thetaddot = cp.H_bm_pinv[:, 0] * y
+    if g_u:
+        thetaddot -= g_u * cp.thetadot
+    if null.u is not None:
+        thetaddot += null.u
+    if null.Pu is not None:
+        thetaddot += null.Pu
+    return thetaddot
 
 
 class AccelerationLaw(CompositeLaw):
