@@ -102,7 +102,7 @@ def _two_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInve
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 
-def rns_projector(H_bm: np.ndarray, H_bm_pinv: np.ndarray | None = None, rank_tol: float = 1e-12) -> np.ndarray:
+def rns_projector(H_bm: np.ndarray, H_bm_pinv: np.ndarray | None = None, *, rank_tol: float = 1e-12) -> np.ndarray:
     """P_RNS = E - H_bm^+ H_bm, the projector onto the reaction null space (Eqs. 9, 10).
 
     ``H_bm_pinv``: the inverse to use, e.g. the damped one the laws use (:func:`damped_pinv`);
