@@ -33,7 +33,7 @@ class TorqueLaw(CompositeLaw):
         tau = cp.H_m @ (vib + arm) + cp.c[m:] + self.model.D_m @ cp.thetadot
         return ControlOutput(
             tau=tau,
-            coupling_momentum=cp.H_bm @ cp.thetadot,
+            coupling_momentum=cp.coupling_momentum,
             sigma_hbm=cp.sigma,
             sigma_jbar=null.sigma_jbar,
             theta_ref=null.theta_ref,

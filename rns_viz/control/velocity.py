@@ -74,7 +74,7 @@ class VelocityLaw:
         tau = realize_acceleration(self.model, cp, q, v, thetaddot)
         return ControlOutput(
             tau=tau,
-            coupling_momentum=cp.H_bm @ cp.thetadot,
+            coupling_momentum=cp.coupling_momentum,
             sigma_hbm=cp.sigma,
             theta_ref=theta_r,
             extra={f"thetadot_cmd_{i + 1}": float(c) for i, c in enumerate(cmd)},
