@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 
@@ -19,15 +18,41 @@ DEFAULT_THRESHOLD = 1e-3
 DEFAULT_MAX_DAMPING = 1e-3
 
 
-class DampedInverse(NamedTuple):
+class DampedInverse:
     """A singularity-robust right inverse A^T (A A^T + lambda^2 E)^-1 and how close A is to singular.
 
-    A named tuple rather than a dataclass: it is built at every control step.
+    Unpacks as (inverse, sigma_min, damping). For one row a the inverse is a^T * ``row_scale``
+    (a number, None for more rows) and is formed only when asked for: per-step code on a 1-DOF
+    base works with the number. A slotted class rather than a dataclass: it is built every step.
     """
 
-    inverse: np.ndarray  # (cols, rows)
-    sigma_min: float  # smallest singular value of A: the distance to singularity
-    damping: float  # lambda actually used (0 away from singularities)
+    __slots__ = ("_inverse", "_row", "damping", "row_scale", "sigma_min")
+
+    def __init__(
+        self,
+        inverse: np.ndarray | None,
+        sigma_min: float,
+        damping: float,
+        row: np.ndarray | None = None,
+        row_scale: float | None = None,
+    ) -> None:
+        self._inverse, self._row = inverse, row  # row: the (1, cols) A when the inverse is a^T row_scale
+        self.sigma_min = sigma_min  # smallest singular value of A: the distance to singularity
+        self.damping = damping  # lambda actually used (0 away from singularities)
+        self.row_scale = row_scale  # 1 / (|a|^2 + lambda^2) for one row, else None
+
+    @property
+    def inverse(self) -> np.ndarray:
+        """(cols, rows) the damped inverse."""
+        if self._inverse is None:
+            self._inverse = self._row.T * self.row_scale  # type: ignore[union-attr, operator]
+        return self._inverse
+
+    def __iter__(self) -> Iterator[np.ndarray | float]:
+        return iter((self.inverse, self.sigma_min, self.damping))
+
+    def __repr__(self) -> str:
+        return f"DampedInverse(sigma_min={self.sigma_min!r}, damping={self.damping!r})"
 
 
 def damped_pinv(
@@ -74,7 +99,7 @@ def _one_row(A: np.ndarray, threshold: float, max_damping: float) -> DampedInver
     sigma2 = sum(map(operator.mul, a, a))
     sigma = math.sqrt(sigma2)
     lam2 = _damping_squared(sigma, threshold, max_damping)
-    return DampedInverse(A.T * (1.0 / (sigma2 + lam2)), sigma, math.sqrt(lam2))
+    return DampedInverse(None, sigma, math.sqrt(lam2), A, 1.0 / (sigma2 + lam2))
 
 
 def _two_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse | None:

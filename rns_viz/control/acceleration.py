@@ -9,6 +9,8 @@ S H_bm (-G_m theta') = -G_m L), its RNS part -G_m P theta' is the default null-s
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 
 from rns_viz.control.common import ControlOutput, Coupling, realize_acceleration
@@ -36,24 +38,24 @@ def _any_coupling_rows(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -
 
 
 def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
-    """Eq. (15) for one coupling row h (a 1-DOF base): H_bm^+ = h^+ is a column, its factor a number.
+    """Eq. (15) for one coupling row h (a 1-DOF base), in Python floats (cheaper than numpy calls here).
 
-    The input's P (u - g_u theta') = u - g_u theta' - h^+ (h u - g_u L) joins that factor:
-        theta'' = h^+ (g_b H_b x_b' - h' theta' - (g_m - g_u) L - h u) + u - g_u theta'.
+    The damped h^+ is h^T s, s = 1 / (|h|^2 + lambda^2), and the input's P (u - g_u theta')
+    = u - g_u theta' - h^+ (h u - g_u L) joins the factor of h^+:
+        theta'' = h^T s (g_b H_b x_b' - h' theta' - (g_m - g_u) L - h u) + u - g_u theta'.
     """
     H_b, xdot_b, hbm_dot_thetadot, L = cp.row_terms()
     g_u = null.damping
     y = g_b * H_b * xdot_b - hbm_dot_thetadot - (g_m - g_u) * L
-    if null.u is not None:
-        y -= cp.H_bm[0].dot(null.u)
-    thetaddot = cp.H_bm_pinv[:, 0] * y
-    if g_u:
-        thetaddot -= g_u * cp.thetadot
-    if null.u is not None:
-        thetaddot += null.u
-    if null.Pu is not None:
-        thetaddot += null.Pu
-    return thetaddot
+    (h,), thetadot = cp.H_bm.tolist(), cp.thetadot.tolist()
+    if null.u is None:
+        alpha = y * cp.inverse.row_scale
+        thetaddot = np.array([alpha * h_i - g_u * w for h_i, w in zip(h, thetadot, strict=True)])
+    else:
+        u = null.u.tolist()
+        alpha = (y - sum(map(operator.mul, h, u))) * cp.inverse.row_scale
+        thetaddot = np.array([alpha * h_i - g_u * w + u_i for h_i, w, u_i in zip(h, thetadot, u, strict=True)])
+    return thetaddot if null.Pu is None else thetaddot + null.Pu
 
 
 class AccelerationLaw(CompositeLaw):

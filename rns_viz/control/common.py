@@ -99,7 +99,6 @@ class Coupling:
 
     __slots__ = (
         "H_bm",
-        "H_bm_pinv",
         "M",
         "_H_b_index",
         "_P",
@@ -110,6 +109,7 @@ class Coupling:
         "_v",
         "c",
         "coupling_momentum",
+        "inverse",
         "sigma",
         "thetadot",
     )
@@ -132,11 +132,16 @@ class Coupling:
         self.H_bm = H_bm  # (r, n) S H_bm
         self.thetadot = v[m:]
         self.coupling_momentum = H_bm.dot(self.thetadot)  # (r,) L = S H_bm theta', Eq. (8)
-        self.H_bm_pinv = inverse.inverse  # (n, r) damped H_bm^+ (rns.damped_pinv)
+        self.inverse = inverse  # the damped H_bm^+ (rns.damped_pinv)
         self.sigma = inverse.sigma_min  # smallest singular value of S H_bm
         self._m, self._rows, self._H_b_index = m, rows, H_b_index
         self._q, self._v, self._hbm_dot = q, v, hbm_dot_thetadot  # (m+n,), (m+n,), (m,)
         self._P: np.ndarray | None = None
+
+    @property
+    def H_bm_pinv(self) -> np.ndarray:
+        """(n, r) the damped H_bm^+."""
+        return self.inverse.inverse
 
     @property
     def H_m(self) -> np.ndarray:
