@@ -103,27 +103,28 @@ def _one_row(A: np.ndarray, threshold: float, max_damping: float) -> DampedInver
 
 
 def _two_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse | None:
-    """Two rows: the 2 x 2 matrix A A^T + lambda^2 E inverted in closed form (None if it is singular).
+    """Two rows a, b: the 2 x 2 matrix A A^T + lambda^2 E inverted in closed form (None if singular).
 
     det(A A^T) is the sum of the squared 2 x 2 minors of A (Lagrange's identity), which keeps
-    sigma_min^2 = det / sigma_max^2 accurate near rank loss, where g00 g11 - g01^2 would cancel.
+    sigma_min^2 = det / sigma_max^2 accurate near rank loss, where g_aa g_bb - g_ab^2 would cancel.
+    Python floats: for a few columns cheaper than numpy calls.
     """
-    a0, a1 = A[0], A[1]
-    g00, g01, g11 = float(a0.dot(a0)), float(a0.dot(a1)), float(a1.dot(a1))
-    outer = np.multiply.outer(a0, a1)
-    minors = outer - outer.T
-    det = 0.5 * float(np.einsum("ij,ij->", minors, minors))
-    half = 0.5 * (g00 - g11)
-    largest = 0.5 * (g00 + g11) + math.sqrt(half * half + g01 * g01)
+    a, b = A.tolist()
+    g_aa, g_ab, g_bb = sum(map(operator.mul, a, a)), sum(map(operator.mul, a, b)), sum(map(operator.mul, b, b))
+    cols = len(a)
+    det = sum((a[i] * b[j] - a[j] * b[i]) ** 2 for i in range(cols) for j in range(i + 1, cols))
+    half = 0.5 * (g_aa - g_bb)
+    largest = 0.5 * (g_aa + g_bb) + math.sqrt(half * half + g_ab * g_ab)
     if largest <= 0.0:  # A = 0
         return None
     sigma = math.sqrt(det / largest)
     lam2 = _damping_squared(sigma, threshold, max_damping)
-    damped_det = det + lam2 * (g00 + g11 + lam2)  # det(A A^T + lambda^2 E)
+    damped_det = det + lam2 * (g_aa + g_bb + lam2)  # det(A A^T + lambda^2 E)
     if not damped_det > 0.0:
         return None
-    d00, d11 = g00 + lam2, g11 + lam2
-    inverse = A.T @ np.array([[d11, -g01], [-g01, d00]]) / damped_det
+    # A^T (A A^T + lambda^2 E)^-1, the 2 x 2 inverse written out
+    d_aa, d_bb, g = (g_aa + lam2) / damped_det, (g_bb + lam2) / damped_det, g_ab / damped_det
+    inverse = np.array([[d_bb * a_i - g * b_i, d_aa * b_i - g * a_i] for a_i, b_i in zip(a, b, strict=True)])
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 
