@@ -81,6 +81,20 @@ class FsmsModel:
         )
         # c_b = H_bm' theta' exactly (M does not depend on x_b): see dynamics()
         self.cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
+        # ee_kinematics: its buffers, the task rows as a slice where they are contiguous, and
+        # whether the base frame is the world's axes at every x_b (translating, no rotated origin)
+        self._v_rel, self._zero_v = np.zeros(model.nv), np.zeros(model.nv)
+        rows = self.task_rows
+        contiguous = len(rows) and np.array_equal(rows, np.arange(rows[0], rows[0] + len(rows)))
+        self._task_index: slice | np.ndarray = slice(int(rows[0]), int(rows[0]) + len(rows)) if contiguous else rows
+        self._base_axes_fixed = self.base_is_translational and bool(
+            np.array_equal(self._base_rotation_at(np.zeros(model.nq)), np.eye(3))
+        )
+
+    def _base_rotation_at(self, q: np.ndarray) -> np.ndarray:
+        data = self.pin_model.createData()
+        pin.forwardKinematics(self.pin_model, data, q)
+        return data.oMi[self.base_joint_id].rotation.copy()
 
     @classmethod
     def from_name(cls, name: str) -> FsmsModel:
@@ -158,17 +172,21 @@ class FsmsModel:
     # -- kinematics ----------------------------------------------------------------------------
     def ee_kinematics(self, q: np.ndarray, thetadot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """J, J' theta' and the end-effector position, all relative to and in the base frame."""
-        model, data, m = self.pin_model, self.data, self.m
-        v_rel = np.concatenate([np.zeros(m), thetadot])
-        pin.forwardKinematics(model, data, q, v_rel, np.zeros(model.nv))
-        pin.updateFramePlacement(model, data, self.ee_frame_id)
+        model, data, m, frame = self.pin_model, self.data, self.m, self.ee_frame_id
+        v_rel = self._v_rel  # (0, theta'): the base frame's own motion is not the arm's
+        v_rel[m:] = thetadot
+        pin.forwardKinematics(model, data, q, v_rel, self._zero_v)
+        pin.updateFramePlacement(model, data, frame)
         base = data.oMi[self.base_joint_id]
+        ee = data.oMf[frame].translation - base.translation
+        acc = pin.getFrameClassicalAcceleration(model, data, frame, pin.LOCAL_WORLD_ALIGNED).linear
+        pin.computeJointJacobians(model, data)  # on the placements just computed: no second pass
+        J_world = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
+        rows = self._task_index
+        if self._base_axes_fixed:  # a translating base without rotated axes: R = E, nothing to rotate
+            return J_world[rows], acc[rows].copy(), ee
         R = base.rotation
-        ee_world = data.oMf[self.ee_frame_id].translation
-        acc = pin.getFrameClassicalAcceleration(model, data, self.ee_frame_id, pin.LOCAL_WORLD_ALIGNED).linear
-        J_world = pin.computeFrameJacobian(model, data, q, self.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
-        rows = self.task_rows
-        return (R.T @ J_world)[rows], (R.T @ acc)[rows], R.T @ (ee_world - base.translation)
+        return (R.T @ J_world)[rows], (R.T @ acc)[rows], R.T @ ee
 
     def ee_position(self, theta: np.ndarray) -> np.ndarray:
         """End-effector position in the base frame, m (forward kinematics by pinocchio)."""
