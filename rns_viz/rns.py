@@ -33,10 +33,10 @@ class DampedInverse:
         inverse: np.ndarray | None,
         sigma_min: float,
         damping: float,
-        row: np.ndarray | None = None,
+        row: list[float] | None = None,
         row_scale: float | None = None,
     ) -> None:
-        self._inverse, self._row = inverse, row  # row: the (1, cols) A when the inverse is a^T row_scale
+        self._inverse, self._row = inverse, row  # row: a (a copy) when the inverse is a^T row_scale
         self.sigma_min = sigma_min  # smallest singular value of A: the distance to singularity
         self.damping = damping  # lambda actually used (0 away from singularities)
         self.row_scale = row_scale  # 1 / (|a|^2 + lambda^2) for one row, else None
@@ -45,7 +45,7 @@ class DampedInverse:
     def inverse(self) -> np.ndarray:
         """(cols, rows) the damped inverse."""
         if self._inverse is None:
-            self._inverse = self._row.T * self.row_scale  # type: ignore[union-attr, operator]
+            self._inverse = np.array(self._row)[:, None] * self.row_scale  # type: ignore[operator]
         return self._inverse
 
     def __iter__(self) -> Iterator[np.ndarray | float]:
@@ -99,7 +99,7 @@ def _one_row(A: np.ndarray, threshold: float, max_damping: float) -> DampedInver
     sigma2 = sum(map(operator.mul, a, a))
     sigma = math.sqrt(sigma2)
     lam2 = _damping_squared(sigma, threshold, max_damping)
-    return DampedInverse(None, sigma, math.sqrt(lam2), A, 1.0 / (sigma2 + lam2))
+    return DampedInverse(None, sigma, math.sqrt(lam2), a, 1.0 / (sigma2 + lam2))
 
 
 def _two_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse | None:

@@ -153,3 +153,14 @@ def test_null_vector_of_a_stack_is_the_stack_of_null_vectors() -> None:
         for Hk, nk in zip(H, stacked, strict=True):
             np.testing.assert_array_equal(nk, null_vector(Hk))
             np.testing.assert_allclose(Hk @ nk, 0.0, atol=1e-13)
+
+
+def test_one_row_inverse_does_not_depend_on_the_matrix_after_the_call() -> None:
+    """The one-row inverse is formed on first use; changing A afterwards must not change it."""
+    A = np.array([[0.3, -0.4, 1.2]])
+    inverse = damped_pinv(A, 1e-3, 1e-3)
+    expected = np.linalg.pinv(A)
+    A[:] = 7.0
+    np.testing.assert_allclose(inverse.inverse, expected, rtol=1e-14)
+    matrix, sigma, damping = inverse  # unpacks like the tuple it was
+    assert matrix is inverse.inverse and sigma == pytest.approx(np.sqrt(0.09 + 0.16 + 1.44)) and damping == 0.0
