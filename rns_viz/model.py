@@ -96,6 +96,20 @@ class FsmsModel:
         )
         # c_b = H_bm' theta' exactly (M does not depend on x_b): see dynamics()
         self.cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
+        # ee_kinematics: its buffers, the task rows as a slice where they are contiguous, and
+        # whether the base frame is the world's axes at every x_b (translating, no rotated origin)
+        self._v_rel, self._zero_v = np.zeros(model.nv), np.zeros(model.nv)
+        rows = self.task_rows
+        contiguous = len(rows) and np.array_equal(rows, np.arange(rows[0], rows[0] + len(rows)))
+        self._task_index: slice | np.ndarray = slice(int(rows[0]), int(rows[0]) + len(rows)) if contiguous else rows
+        self._base_axes_fixed = self.base_is_translational and bool(
+            np.array_equal(self._base_rotation_at(np.zeros(model.nq)), np.eye(3))
+        )
+
+    def _base_rotation_at(self, q: np.ndarray) -> np.ndarray:
+        data = self.pin_model.createData()
+        pin.forwardKinematics(self.pin_model, data, q)
+        return data.oMi[self.base_joint_id].rotation.copy()
 
     @classmethod
     def from_name(cls, name: str) -> FsmsModel:
@@ -125,13 +139,16 @@ class FsmsModel:
         return np.concatenate([xb, np.asarray(theta, dtype=float)])
 
     # -- dynamics ------------------------------------------------------------------------------
-    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """Joint-space inertia matrix of Eq. (1), full and symmetric."""
-        return pin.crba(self.pin_model, self.data, q)
+    def mass_matrix(self, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+        """Joint-space inertia matrix of Eq. (1), full and symmetric.
 
-    def coupling_matrix(self, q: np.ndarray) -> np.ndarray:
+        ``data``: pinocchio data to work in (default: the model's own, which the laws also use).
+        """
+        return pin.crba(self.pin_model, self.data if data is None else data, q)
+
+    def coupling_matrix(self, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """S H_bm: the rows of the inertia coupling matrix selected by S (Sec. III-B)."""
-        return self.mass_matrix(q)[self.selected, self.m :]
+        return self.mass_matrix(q, data)[self.selected, self.m :]
 
     def dynamics(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, the velocity terms c = (c_b, c_m) and H_bm' theta' at (q, v): what the laws need.
@@ -174,17 +191,21 @@ class FsmsModel:
     # -- kinematics ----------------------------------------------------------------------------
     def ee_kinematics(self, q: np.ndarray, thetadot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """J, J' theta' and the end-effector position, all relative to and in the base frame."""
-        model, data, m = self.pin_model, self.data, self.m
-        v_rel = np.concatenate([np.zeros(m), thetadot])
-        pin.forwardKinematics(model, data, q, v_rel, np.zeros(model.nv))
-        pin.updateFramePlacement(model, data, self.ee_frame_id)
+        model, data, m, frame = self.pin_model, self.data, self.m, self.ee_frame_id
+        v_rel = self._v_rel  # (0, theta'): the base frame's own motion is not the arm's
+        v_rel[m:] = thetadot
+        pin.forwardKinematics(model, data, q, v_rel, self._zero_v)
+        pin.updateFramePlacement(model, data, frame)
         base = data.oMi[self.base_joint_id]
+        ee = data.oMf[frame].translation - base.translation
+        acc = pin.getFrameClassicalAcceleration(model, data, frame, pin.LOCAL_WORLD_ALIGNED).linear
+        pin.computeJointJacobians(model, data)  # on the placements just computed: no second pass
+        J_world = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
+        rows = self._task_index
+        if self._base_axes_fixed:  # a translating base without rotated axes: R = E, nothing to rotate
+            return J_world[rows], acc[rows].copy(), ee
         R = base.rotation
-        ee_world = data.oMf[self.ee_frame_id].translation
-        acc = pin.getFrameClassicalAcceleration(model, data, self.ee_frame_id, pin.LOCAL_WORLD_ALIGNED).linear
-        J_world = pin.computeFrameJacobian(model, data, q, self.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
-        rows = self.task_rows
-        return (R.T @ J_world)[rows], (R.T @ acc)[rows], R.T @ (ee_world - base.translation)
+        return (R.T @ J_world)[rows], (R.T @ acc)[rows], R.T @ ee
 
     def ee_position(self, theta: np.ndarray) -> np.ndarray:
         """End-effector position in the base frame, m (forward kinematics by pinocchio)."""

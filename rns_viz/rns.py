@@ -6,9 +6,9 @@ Pure numpy on matrices that the model supplies; no pinocchio, no viser.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+import operator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 
@@ -18,64 +18,137 @@ DEFAULT_THRESHOLD = 1e-3
 DEFAULT_MAX_DAMPING = 1e-3
 
 
-class DampedInverse(NamedTuple):
+class DampedInverse:
     """A singularity-robust right inverse A^T (A A^T + lambda^2 E)^-1 and how close A is to singular.
 
-    A named tuple rather than a dataclass: it is built at every control step.
+    Unpacks as (inverse, sigma_min, damping). For one row a the inverse is a^T * ``row_scale``
+    (a number, None for more rows) and is formed only when asked for: per-step code on a 1-DOF
+    base works with the number. A slotted class rather than a dataclass: it is built every step.
     """
 
-    inverse: np.ndarray  # (cols, rows)
-    sigma_min: float  # smallest singular value of A: the distance to singularity
-    damping: float  # lambda actually used (0 away from singularities)
+    __slots__ = ("_inverse", "_row", "damping", "row_scale", "sigma_min")
+
+    def __init__(
+        self,
+        inverse: np.ndarray | None,
+        sigma_min: float,
+        damping: float,
+        row: list[float] | None = None,
+        row_scale: float | None = None,
+    ) -> None:
+        self._inverse, self._row = inverse, row  # row: a (a copy) when the inverse is a^T row_scale
+        self.sigma_min = sigma_min  # smallest singular value of A: the distance to singularity
+        self.damping = damping  # lambda actually used (0 away from singularities)
+        self.row_scale = row_scale  # 1 / (|a|^2 + lambda^2) for one row, else None
+
+    @property
+    def inverse(self) -> np.ndarray:
+        """(cols, rows) the damped inverse."""
+        if self._inverse is None:
+            self._inverse = np.array(self._row)[:, None] * self.row_scale  # type: ignore[operator]
+        return self._inverse
+
+    def __iter__(self) -> Iterator[np.ndarray | float]:
+        return iter((self.inverse, self.sigma_min, self.damping))
+
+    def __repr__(self) -> str:
+        return f"DampedInverse(sigma_min={self.sigma_min!r}, damping={self.damping!r})"
 
 
 def damped_pinv(
     A: np.ndarray, threshold: float = DEFAULT_THRESHOLD, max_damping: float = DEFAULT_MAX_DAMPING
 ) -> DampedInverse:
-    """Right pseudoinverse of a wide matrix, damped near rank loss so it always stays finite.
+    """Right pseudoinverse A^T (A A^T + lambda^2 E)^-1 of a wide matrix, damped near rank loss.
 
-    lambda^2 = (1 - (sigma_min/threshold)^2) max_damping^2 when sigma_min < threshold, else 0.
+    lambda^2 = (1 - (sigma_min/threshold)^2) max_damping^2 when sigma_min < threshold, else 0, so
+    the inverse stays finite at singularities. The one damped inverse of the project: H_bm^+ in
+    Eqs. (9), (15), (16), (30) and J-bar^+ in Eq. (24). One and two rows (the 1-DOF base, the
+    planar task) take closed forms; more rows an SVD and a solve.
     """
-    A = np.atleast_2d(np.asarray(A, dtype=float))
+    if type(A) is not np.ndarray or A.ndim != 2 or A.dtype.char != "d":  # per step: skip when it is one
+        A = np.atleast_2d(np.asarray(A, dtype=float))
     rows = A.shape[0]
-    if rows == 1:  # closed form for a single row (the 1-DOF base): ~20x cheaper than an SVD
-        a = A[0]
-        inverse, sigma, lam2 = damped_row_inverse(a, threshold, max_damping)
-        return DampedInverse(inverse[:, None], sigma, math.sqrt(lam2))
-    sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
-    lam2 = damping_squared(sigma, threshold, max_damping)
-    inverse = A.T @ np.linalg.solve(A @ A.T + lam2 * np.eye(rows), np.eye(rows))
-    return DampedInverse(inverse, sigma, math.sqrt(lam2))
+    if rows == 1:
+        return _one_row(A, threshold, max_damping)
+    if rows == 2:
+        closed = _two_rows(A, threshold, max_damping)
+        if closed is not None:
+            return closed
+    return _any_rows(A, threshold, max_damping)
 
 
-def damped_row_inverse(a: np.ndarray, threshold: float, max_damping: float) -> tuple[np.ndarray, float, float]:
-    """The damped inverse of one row a, as the column a / (|a|^2 + lambda^2), with sigma = |a| and lambda^2.
-
-    Plain floats and two numpy calls: this runs at every control step of a 1-DOF base.
-    """
-    sigma2 = float(a.dot(a))
-    sigma = math.sqrt(sigma2)
-    lam2 = damping_squared(sigma, threshold, max_damping)
-    return a / (sigma2 + lam2), sigma, lam2
-
-
-def damping_squared(sigma: float, threshold: float, max_damping: float) -> float:
+def _damping_squared(sigma: float, threshold: float, max_damping: float) -> float:
     """lambda^2 of the damped inverse for smallest singular value sigma (0 above ``threshold``)."""
     if sigma >= threshold:
         return 0.0
     return (1.0 - (sigma / threshold) ** 2) * max_damping**2
 
 
-def rns_projector(H_bm: np.ndarray, rank_tol: float = 1e-12) -> np.ndarray:
-    """P_RNS = E - H_bm^+ H_bm, the orthogonal projector onto the reaction null space (Eq. 9).
+def _any_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
+    """Any number of rows: sigma_min from the SVD, then a solve with A A^T + lambda^2 E."""
+    rows = A.shape[0]
+    sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
+    lam2 = _damping_squared(sigma, threshold, max_damping)
+    inverse = A.T @ np.linalg.solve(A @ A.T + lam2 * np.eye(rows), np.eye(rows))
+    return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
-    Built from the SVD's null-space basis, so it is exactly symmetric and idempotent.
+
+def _one_row(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
+    """One row a: the column a / (|a|^2 + lambda^2), sigma = |a|. Python floats, no SVD."""
+    (a,) = A.tolist()
+    sigma2 = sum(map(operator.mul, a, a))
+    sigma = math.sqrt(sigma2)
+    lam2 = _damping_squared(sigma, threshold, max_damping)
+    return DampedInverse(None, sigma, math.sqrt(lam2), a, 1.0 / (sigma2 + lam2))
+
+
+def _two_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse | None:
+    """Two rows a, b: the 2 x 2 matrix A A^T + lambda^2 E inverted in closed form (None if singular).
+
+    det(A A^T) is the sum of the squared 2 x 2 minors of A (Lagrange's identity), which keeps
+    sigma_min^2 = det / sigma_max^2 accurate near rank loss, where g_aa g_bb - g_ab^2 would cancel.
+    Python floats: for a few columns cheaper than numpy calls.
+    """
+    a, b = A.tolist()
+    g_aa, g_ab, g_bb = sum(map(operator.mul, a, a)), sum(map(operator.mul, a, b)), sum(map(operator.mul, b, b))
+    cols = len(a)
+    det = sum((a[i] * b[j] - a[j] * b[i]) ** 2 for i in range(cols) for j in range(i + 1, cols))
+    half = 0.5 * (g_aa - g_bb)
+    largest = 0.5 * (g_aa + g_bb) + math.sqrt(half * half + g_ab * g_ab)
+    if largest <= 0.0:  # A = 0
+        return None
+    sigma = math.sqrt(det / largest)
+    lam2 = _damping_squared(sigma, threshold, max_damping)
+    damped_det = det + lam2 * (g_aa + g_bb + lam2)  # det(A A^T + lambda^2 E)
+    if not damped_det > 0.0:
+        return None
+    # A^T (A A^T + lambda^2 E)^-1, the 2 x 2 inverse written out
+    d_aa, d_bb, g = (g_aa + lam2) / damped_det, (g_bb + lam2) / damped_det, g_ab / damped_det
+    inverse = np.array([[d_bb * a_i - g * b_i, d_aa * b_i - g * a_i] for a_i, b_i in zip(a, b, strict=True)])
+    return DampedInverse(inverse, sigma, math.sqrt(lam2))
+
+
+def rns_projector(H_bm: np.ndarray, H_bm_pinv: np.ndarray | None = None, *, rank_tol: float = 1e-12) -> np.ndarray:
+    """P_RNS = E - H_bm^+ H_bm, the projector onto the reaction null space (Eqs. 9, 10).
+
+    ``H_bm_pinv``: the inverse to use, e.g. the damped one the laws use (:func:`damped_pinv`);
+    by default the Moore-Penrose inverse, for which H_bm^+ H_bm = V_r V_r^T with V_r the SVD's
+    row-space basis: P is then exactly symmetric and idempotent.
     """
     H = np.atleast_2d(np.asarray(H_bm, dtype=float))
+    if H_bm_pinv is not None:
+        return np.eye(H.shape[1]) - H_bm_pinv @ H
     _, s, Vt = np.linalg.svd(H)
     rank = int(np.sum(s > rank_tol * max(1.0, s[0] if s.size else 0.0)))
     range_basis = Vt[:rank]
     return np.eye(H.shape[1]) - range_basis.T @ range_basis
+
+
+def project_onto_rns(u: np.ndarray, H_bm: np.ndarray, H_bm_pinv: np.ndarray) -> np.ndarray:
+    """P_RNS u = u - H_bm^+ (H_bm u): :func:`rns_projector` applied to one vector, P never formed."""
+    if H_bm_pinv.shape[1] == 1:  # one coupling row: a scalar times the inverse column
+        return u - H_bm_pinv[:, 0] * H_bm[0].dot(u)
+    return u - H_bm_pinv @ (H_bm @ u)
 
 
 def null_vector(H_bm: np.ndarray) -> np.ndarray:
@@ -83,14 +156,18 @@ def null_vector(H_bm: np.ndarray) -> np.ndarray:
 
     n_i = (-1)^i det(H_bm without column i). For m = 1 this is Eq. (27), n = (h_2, -h_1).
     It is smooth, has the magnitude of the rows' volume, and vanishes where H_bm loses rank.
+    ``H_bm`` may be one (m, m + 1) matrix or a stack (K, m, m + 1); n is then (K, m + 1).
     """
-    H = np.atleast_2d(np.asarray(H_bm, dtype=float))
-    rows, cols = H.shape
+    H = np.asarray(H_bm, dtype=float)
+    if H.ndim == 1:
+        H = H[None]
+    rows, cols = H.shape[-2:]
     if cols != rows + 1:
         raise ValueError(f"null_vector needs an m x (m+1) matrix for a 1-D RNS, got {H.shape}")
     if rows == 1:
-        return np.array([H[0, 1], -H[0, 0]])
-    return np.array([(-1) ** i * np.linalg.det(np.delete(H, i, axis=1)) for i in range(cols)])
+        return np.stack([H[..., 0, 1], -H[..., 0, 0]], axis=-1)
+    minors = [np.linalg.det(np.delete(H, i, axis=-1)) for i in range(cols)]
+    return np.stack([minor if i % 2 == 0 else -minor for i, minor in enumerate(minors)], axis=-1)
 
 
 def restricted_jacobian(J: np.ndarray, P_rns: np.ndarray) -> np.ndarray:

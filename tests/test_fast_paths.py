@@ -1,37 +1,77 @@
-"""The simulator's fast paths give what the plain formulas give (issue "Figures to reach", performance)."""
+"""Fast branches (one coupling row, a 1-DOF base) give what the general formulas give; the simulator's fast paths."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rns_viz.control import AccelerationLaw, FixedReference, Gains, JointServo
-from rns_viz.control.null_input import DampNullMotion
+from rns_viz.control import (
+    AccelerationLaw,
+    DampNullMotion,
+    FixedReference,
+    Gains,
+    JointSample,
+    JointServo,
+    TrackJointReference,
+    acceleration,
+    common,
+)
+from rns_viz.control.acceleration import composite_acceleration
 from rns_viz.model import FsmsModel
 from rns_viz.sim import ForcePulse, Simulator
 
 
-class PlainDamping(DampNullMotion):
-    """The same null input, but not the exact type: AccelerationLaw takes its general path (numpy, P formed)."""
+def random_states(model: FsmsModel, count: int, rng: np.random.Generator) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(q, v) with random angles; every tenth on a singularity of H_bm (arm along the base axis)."""
+    singular = [np.zeros(model.n), np.r_[np.pi, np.zeros(model.n - 1)]]
+    states = []
+    for k in range(count):
+        theta = singular[k % 2] if k % 10 == 0 else rng.uniform(-np.pi, np.pi, model.n)
+        states.append(
+            (np.concatenate([rng.uniform(-0.02, 0.02, model.m), theta]), rng.normal(scale=0.5, size=model.nv))
+        )
+    return states
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_default_null_input_shortcut_equals_general_law(name: str) -> None:
+def test_one_row_branches_equal_the_general_ones(name: str) -> None:
+    """Eq. (15) and the resolved acceleration of Fig. 1: the 1-DOF-base branches give what the
+    general (any rows, numpy blocks and a solve) branches give, to rounding, singularities included."""
     model = FsmsModel.from_name(name)
     rng = np.random.default_rng(7)
-    singular = [np.zeros(model.n), np.r_[np.pi, np.zeros(model.n - 1)]]
-    for k in range(200):
-        theta = singular[k % 2] if k % 10 == 0 else rng.uniform(-np.pi, np.pi, model.n)
-        q = np.concatenate([rng.uniform(-0.02, 0.02, model.m), theta])
-        v = rng.normal(scale=0.5, size=model.nv)
+    for q, v in random_states(model, 200, rng):
         gains = Gains(g_b=rng.uniform(0, 30), g_m=rng.uniform(0, 30))
-        g_u = gains.g_m if k % 2 else rng.uniform(0, 30)  # the null input may have its own gain
-        fast = AccelerationLaw(model, gains, null_input=DampNullMotion(g_u))(0.0, q, v)
-        plain = AccelerationLaw(model, gains, null_input=PlainDamping(g_u))(0.0, q, v)
-        scale = 1.0 + np.abs(plain.tau).max()
-        np.testing.assert_allclose(fast.tau, plain.tau, atol=1e-12 * scale, rtol=0)
-        np.testing.assert_allclose(fast.coupling_momentum, plain.coupling_momentum, rtol=1e-13, atol=1e-16)
-        assert fast.sigma_hbm == pytest.approx(plain.sigma_hbm, rel=1e-14)
+        inputs = [
+            DampNullMotion(rng.uniform(0, 30)),
+            TrackJointReference(JointSample.held(rng.uniform(-1, 1, model.n)), 40.0, 10.0),
+        ]
+        for null_input in inputs:
+            law = AccelerationLaw(model, gains, null_input=null_input)
+            cp = law.coupling(q, v)
+            null = null_input(0.0, cp, q, v)
+            fast = acceleration._one_coupling_row(cp, gains.g_b, gains.g_m, null)
+            general = acceleration._any_coupling_rows(cp, gains.g_b, gains.g_m, null)
+            np.testing.assert_allclose(fast, general, rtol=0, atol=1e-12 * (1.0 + np.abs(general).max()))
+            tau_fast = common._one_dof_base_torques(model, cp, q, v, general)
+            tau_general = common._any_base_torques(model, cp, q, v, general)
+            np.testing.assert_allclose(tau_fast, tau_general, rtol=0, atol=1e-12 * (1.0 + np.abs(tau_general).max()))
+
+
+def test_null_input_is_projected_into_the_rns(planar3r: FsmsModel) -> None:
+    """Eq. (14): whatever u, the law's P u leaves the coupling momentum's rate unchanged: H_bm P u = 0
+    up to the damping of H_bm^+ (none away from singularities)."""
+    rng = np.random.default_rng(8)
+    for q, v in random_states(planar3r, 50, rng)[1:]:
+        law = AccelerationLaw(
+            planar3r, Gains(g_b=0.0, g_m=0.0), TrackJointReference(JointSample.held(q[1:] + 1), 9.0, 3.0)
+        )
+        cp = law.coupling(q, v)
+        if cp.sigma < law.coupling.threshold:
+            continue
+        null = law.null_input(0.0, cp, q, v)
+        with_input = composite_acceleration(cp, 0.0, 0.0, null)
+        without = composite_acceleration(cp, 0.0, 0.0, type(null)())
+        np.testing.assert_allclose(cp.H_bm @ (with_input - without), 0.0, atol=1e-12 * np.abs(null.u).max())
 
 
 def test_coupling_blocks_match_the_mass_matrix(planar3r: FsmsModel) -> None:

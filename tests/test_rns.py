@@ -5,8 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rns_viz import rns
 from rns_viz.model import FsmsModel
-from rns_viz.rns import check_integrability, damped_pinv, null_vector, restricted_jacobian, rns_projector
+from rns_viz.rns import (
+    check_integrability,
+    damped_pinv,
+    null_vector,
+    project_onto_rns,
+    restricted_jacobian,
+    rns_projector,
+)
 
 RNG = np.random.default_rng(3)
 
@@ -97,3 +105,62 @@ def test_integrability_detects_a_nonholonomic_distribution() -> None:
     result = check_integrability(lambda th: np.array([[-th[1], 0.0, 1.0]]), RNG.normal(size=(5, 3)))
     assert not result.integrable
     assert result.max_residual > 0.1
+
+
+def near_singular(rows: int, cols: int, sigma: float) -> np.ndarray:
+    """A random rows x cols matrix whose smallest singular value is ``sigma`` (the others ~1)."""
+    U, _ = np.linalg.qr(RNG.normal(size=(rows, rows)))
+    V, _ = np.linalg.qr(RNG.normal(size=(cols, cols)))
+    s = np.r_[RNG.uniform(0.5, 2.0, rows - 1), sigma]
+    return U @ np.diag(s) @ V[:rows]
+
+
+@pytest.mark.parametrize("rows", [1, 2])
+@pytest.mark.parametrize("sigma", [1.0, 0.3, 0.051, 0.049, 1e-2, 1e-4, 1e-8, 0.0])
+def test_closed_form_branches_equal_the_svd_branch(rows: int, sigma: float) -> None:
+    """The one- and two-row closed forms of damped_pinv against its SVD branch, near and at rank loss."""
+    threshold = 0.05
+    for cols in (2, 3, 7):
+        for _ in range(20):
+            A = near_singular(rows, cols, sigma) if rows == 2 else RNG.normal(size=(1, cols))
+            if rows == 1:
+                A *= sigma / np.linalg.norm(A) if sigma > 0 else 0.0
+            closed = damped_pinv(A, threshold, threshold)
+            svd = rns._any_rows(A, threshold, threshold)
+            scale = np.abs(svd.inverse).max()
+            np.testing.assert_allclose(closed.inverse, svd.inverse, rtol=0, atol=1e-12 * max(scale, 1.0))
+            assert closed.sigma_min == pytest.approx(svd.sigma_min, rel=1e-9, abs=1e-12)
+            assert closed.damping == pytest.approx(svd.damping, rel=1e-9, abs=1e-12)
+
+
+def test_damped_projector_applied_equals_formed() -> None:
+    """P_RNS u without forming P equals the formed (damped) P_RNS times u, Eq. (9)."""
+    for rows in (1, 2):
+        for sigma in (1.0, 1e-4):
+            H = near_singular(rows, rows + 2, sigma)
+            inverse = damped_pinv(H, 1e-2, 1e-2).inverse
+            u = RNG.normal(size=rows + 2)
+            np.testing.assert_allclose(project_onto_rns(u, H, inverse), rns_projector(H, inverse) @ u, atol=1e-14)
+            if sigma == 1.0:  # undamped: the damped projector is the exact one
+                np.testing.assert_allclose(rns_projector(H, inverse), rns_projector(H), atol=1e-14)
+
+
+def test_null_vector_of_a_stack_is_the_stack_of_null_vectors() -> None:
+    for rows in (1, 2, 3):
+        H = RNG.normal(size=(6, rows, rows + 1))
+        stacked = null_vector(H)
+        assert stacked.shape == (6, rows + 1)
+        for Hk, nk in zip(H, stacked, strict=True):
+            np.testing.assert_array_equal(nk, null_vector(Hk))
+            np.testing.assert_allclose(Hk @ nk, 0.0, atol=1e-13)
+
+
+def test_one_row_inverse_does_not_depend_on_the_matrix_after_the_call() -> None:
+    """The one-row inverse is formed on first use; changing A afterwards must not change it."""
+    A = np.array([[0.3, -0.4, 1.2]])
+    inverse = damped_pinv(A, 1e-3, 1e-3)
+    expected = np.linalg.pinv(A)
+    A[:] = 7.0
+    np.testing.assert_allclose(inverse.inverse, expected, rtol=1e-14)
+    matrix, sigma, damping = inverse  # unpacks like the tuple it was
+    assert matrix is inverse.inverse and sigma == pytest.approx(np.sqrt(0.09 + 0.16 + 1.44)) and damping == 0.0

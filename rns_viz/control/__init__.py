@@ -1,6 +1,6 @@
 """The paper's control laws, one module each, one call signature: law(t, q, v) -> ControlOutput."""
 
-from rns_viz.control.acceleration import AccelerationLaw
+from rns_viz.control.acceleration import AccelerationLaw, composite_acceleration
 from rns_viz.control.common import ControlLaw, ControlOutput, Gains, InvalidGain, LawKind
 from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.null_input import (
@@ -43,4 +43,5 @@ __all__ = [
     "TrackEndEffector",
     "TrackJointReference",
     "VelocityLaw",
+    "composite_acceleration",
 ]

@@ -9,15 +9,53 @@ S H_bm (-G_m theta') = -G_m L), its RNS part -G_m P theta' is the default null-s
 
 from __future__ import annotations
 
-import math
 import operator
 
 import numpy as np
 
-from rns_viz.control.common import ControlOutput, Coupling, range_acceleration, realize_acceleration
+from rns_viz.control.common import ControlOutput, Coupling, realize_acceleration
 from rns_viz.control.composite import CompositeLaw
-from rns_viz.control.null_input import DampNullMotion, NullOutput
-from rns_viz.rns import damping_squared
+from rns_viz.control.null_input import NullOutput
+
+
+def composite_acceleration(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
+    """theta'' of Eq. (15) with G_b = g_b E, G_m = g_m E and the null-space input ``null``:
+
+        theta'' = H_bm^+ (H_b G_b x_b' - H_bm' theta' - G_m L) + P_RNS u.
+
+    -G_m L is the law's -G_m (E - P) theta', because (E - P) theta' = H_bm^+ H_bm theta' = H_bm^+ L
+    (Eqs. 8, 9), also with the damped inverse.
+    """
+    if cp.H_bm.shape[0] == 1:
+        return _one_coupling_row(cp, g_b, g_m, null)
+    return _any_coupling_rows(cp, g_b, g_m, null)
+
+
+def _any_coupling_rows(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
+    """Eq. (15) for any number of coupling rows, as written above."""
+    y = g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum
+    return cp.H_bm_pinv @ y + null.in_rns(cp)
+
+
+def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
+    """Eq. (15) for one coupling row h (a 1-DOF base), in Python floats (cheaper than numpy calls here).
+
+    The damped h^+ is h^T s, s = 1 / (|h|^2 + lambda^2), and the input's P (u - g_u theta')
+    = u - g_u theta' - h^+ (h u - g_u L) joins the factor of h^+:
+        theta'' = h^T s (g_b H_b x_b' - h' theta' - (g_m - g_u) L - h u) + u - g_u theta'.
+    """
+    H_b, xdot_b, hbm_dot_thetadot, L = cp.row_terms()
+    g_u = null.damping
+    y = g_b * H_b * xdot_b - hbm_dot_thetadot - (g_m - g_u) * L
+    (h,), thetadot = cp.H_bm.tolist(), cp.thetadot.tolist()
+    if null.u is None:
+        alpha = y * cp.inverse.row_scale
+        thetaddot = np.array([alpha * h_i - g_u * w for h_i, w in zip(h, thetadot, strict=True)])
+    else:
+        u = null.u.tolist()
+        alpha = (y - sum(map(operator.mul, h, u))) * cp.inverse.row_scale
+        thetaddot = np.array([alpha * h_i - g_u * w + u_i for h_i, w, u_i in zip(h, thetadot, u, strict=True)])
+    return thetaddot if null.Pu is None else thetaddot + null.Pu
 
 
 class AccelerationLaw(CompositeLaw):
@@ -26,17 +64,12 @@ class AccelerationLaw(CompositeLaw):
     kind = "acceleration"
 
     def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, Coupling, NullOutput]:
-        """theta'' of Eq. (15), with the coupling and null-space input it used.
-
-        -G_m (E - P) theta' = -G_m H_bm^+ L is part of :func:`range_acceleration`.
-        """
+        """theta'' of Eq. (15) (:func:`composite_acceleration`), with the coupling and null-space input it used."""
         cp = self.coupling(q, v)
         null = self.null_input(t, cp, q, v)
-        return range_acceleration(cp, self.suppression_gain(t), self.gains.g_m) + null.Pu, cp, null
+        return composite_acceleration(cp, self.suppression_gain(t), self.gains.g_m, null), cp, null
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
-        if self.model.m == 1 and type(self.null_input) is DampNullMotion:
-            return self._one_dof_base(t, q, v)
         thetaddot, cp, null = self.acceleration(t, q, v)
         return ControlOutput(
             tau=realize_acceleration(self.model, cp, q, v, thetaddot),
@@ -46,39 +79,3 @@ class AccelerationLaw(CompositeLaw):
             theta_ref=null.theta_ref,
             ee_ref=null.ee_ref,
         )
-
-    def _one_dof_base(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
-        """:meth:`__call__` for a 1-DOF base (TREP, the 3R) and the default null input, in plain numbers.
-
-        With u = -G_u theta' (Fig. 3), P u = -G_u theta' + G_u h^+ L, so Eq. (15) reads
-            theta'' = h^+ (H_b g_b x_b' - h' theta' - (g_m - G_u) L) - G_u theta',  h^+ = h / (|h|^2 + lambda^2)
-        for the coupling row h = H_bm and L = h theta' (Eq. 8), and resolved acceleration (Fig. 1) gives
-            x_b'' = (-k x_b - d x_b' - c_b - h theta'') / H_b,  tau = h^T x_b'' + H_m theta'' + c_m + D_m theta'.
-        Python floats instead of numpy arrays: for a few joints each numpy call costs more than its
-        arithmetic. M, c and H_bm' theta' still come from pinocchio (model.dynamics).
-        """
-        model, coupling = self.model, self.coupling
-        M, c, hbm_dot = model.dynamics(q, v)
-        (H_b, *h), *arm_rows = M.tolist()
-        c_b, *c_m = c.tolist()
-        xdot_b, *thetadot = v.tolist()
-        sigma2 = _dot(h, h)
-        sigma = math.sqrt(sigma2)
-        lam2 = damping_squared(sigma, coupling.threshold, coupling.max_damping)
-        L = _dot(h, thetadot)
-        g_u = self.null_input.g_m
-        y = self.suppression_gain(t) * H_b * xdot_b - hbm_dot.item(0) - (self.gains.g_m - g_u) * L
-        alpha = y / (sigma2 + lam2)
-        thetaddot = [alpha * h_i - g_u * w_i for h_i, w_i in zip(h, thetadot, strict=True)]
-        spring = -model.K_b.item(0) * q.item(0) - model.D_b.item(0) * xdot_b
-        xddot_b = (spring - c_b - _dot(h, thetaddot)) / H_b
-        tau = np.array(
-            [h_i * xddot_b + _dot(row[1:], thetaddot) + c_i for h_i, row, c_i in zip(h, arm_rows, c_m, strict=True)]
-        )
-        if model.has_joint_damping:
-            tau += model.D_m @ v[1:]
-        return ControlOutput(tau=tau, coupling_momentum=np.array([L]), sigma_hbm=sigma)
-
-
-def _dot(a: list[float], b: list[float]) -> float:
-    return sum(map(operator.mul, a, b))

@@ -16,7 +16,7 @@ from rns_viz.model import FsmsModel
 
 if TYPE_CHECKING:
     from rns_viz.control.reference import ReferenceSample
-from rns_viz.rns import damped_pinv, damped_row_inverse
+from rns_viz.rns import DampedInverse, damped_pinv, project_onto_rns, rns_projector
 
 LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
@@ -94,15 +94,13 @@ class Coupling:
 
     Built at every control step, so it is a plain slotted class that stores what every law uses
     and forms the rest on access: P_RNS (an n x n matrix usually applied to one vector, see
-    :meth:`project`), H_b, x_b, x_b', H_bm' theta', theta and the (n, r) inverse.
+    :meth:`project`), H_b, x_b, x_b', H_bm' theta' and theta.
     """
 
     __slots__ = (
         "H_bm",
-        "H_m",
         "M",
         "_H_b_index",
-        "_H_bm_pinv",
         "_P",
         "_hbm_dot",
         "_m",
@@ -111,7 +109,7 @@ class Coupling:
         "_v",
         "c",
         "coupling_momentum",
-        "row_pinv",
+        "inverse",
         "sigma",
         "thetadot",
     )
@@ -122,7 +120,7 @@ class Coupling:
         c: np.ndarray,
         hbm_dot_thetadot: np.ndarray,
         H_bm: np.ndarray,
-        inverse: tuple[np.ndarray | None, np.ndarray | None, float],
+        inverse: DampedInverse,
         q: np.ndarray,
         v: np.ndarray,
         rows: slice | np.ndarray,
@@ -132,14 +130,23 @@ class Coupling:
         self.M = M  # (m+n, m+n) joint-space inertia matrix of Eq. (1)
         self.c = c  # (m+n,) velocity terms (c_b, c_m)
         self.H_bm = H_bm  # (r, n) S H_bm
-        self.H_m = M[m:, m:]  # (n, n)
         self.thetadot = v[m:]
         self.coupling_momentum = H_bm.dot(self.thetadot)  # (r,) L = S H_bm theta', Eq. (8)
-        # The damped inverse: (n,) for a single row (r = 1) or None; (n, r) or None; sigma_min.
-        self.row_pinv, self._H_bm_pinv, self.sigma = inverse
+        self.inverse = inverse  # the damped H_bm^+ (rns.damped_pinv)
+        self.sigma = inverse.sigma_min  # smallest singular value of S H_bm
         self._m, self._rows, self._H_b_index = m, rows, H_b_index
         self._q, self._v, self._hbm_dot = q, v, hbm_dot_thetadot  # (m+n,), (m+n,), (m,)
         self._P: np.ndarray | None = None
+
+    @property
+    def H_bm_pinv(self) -> np.ndarray:
+        """(n, r) the damped H_bm^+."""
+        return self.inverse.inverse
+
+    @property
+    def H_m(self) -> np.ndarray:
+        """(n, n) arm block of the inertia matrix."""
+        return self.M[self._m :, self._m :]
 
     @property
     def H_b(self) -> np.ndarray:
@@ -167,29 +174,20 @@ class Coupling:
         return self._q[self._m :]
 
     @property
-    def H_bm_pinv(self) -> np.ndarray:
-        """(n, r) damped H_bm^+."""
-        if self._H_bm_pinv is None:
-            self._H_bm_pinv = self.row_pinv[:, None]
-        return self._H_bm_pinv
-
-    @property
     def P(self) -> np.ndarray:
-        """(n, n) P_RNS = E - H_bm^+ H_bm, Eq. (9), with the damped inverse."""
+        """(n, n) P_RNS of Eq. (9) with the damped inverse (:func:`rns_viz.rns.rns_projector`)."""
         if self._P is None:
-            self._P = np.eye(self.H_bm.shape[1]) - self.H_bm_pinv @ self.H_bm
+            self._P = rns_projector(self.H_bm, self.H_bm_pinv)
         return self._P
 
     def project(self, u: np.ndarray) -> np.ndarray:
-        """P_RNS u = u - H_bm^+ (H_bm u) without forming P_RNS."""
-        if self.row_pinv is not None:
-            return u - self.row_pinv * self.H_bm[0].dot(u)
-        return u - self.H_bm_pinv @ (self.H_bm @ u)
+        """P_RNS u without forming P_RNS (:func:`rns_viz.rns.project_onto_rns`)."""
+        return project_onto_rns(u, self.H_bm, self.H_bm_pinv)
 
     def row_terms(self) -> tuple[float, float, float, float]:
         """H_b, x_b', H_bm' theta' and L of the single selected row (r = 1), as numbers."""
-        i = self._rows.start if isinstance(self._rows, slice) else int(self._rows[0])
-        return self.M[i, i], self._v[i], self._hbm_dot[i], self.coupling_momentum[0]
+        i = self._rows.start if type(self._rows) is slice else int(self._rows[0])
+        return self.M.item(i, i), self._v.item(i), self._hbm_dot.item(i), self.coupling_momentum.item(0)
 
 
 class CouplingEvaluator:
@@ -203,27 +201,20 @@ class CouplingEvaluator:
         all_rows = len(self.rows) == m
         self._rows: slice | np.ndarray = slice(0, m) if all_rows else self.rows
         self._H_b_index = (slice(0, m), slice(0, m)) if all_rows else np.ix_(self.rows, self.rows)
-        self._single_row = len(self.rows) == 1
         # Damping starts below 10 % of sigma_min(S H_bm) at the default configuration (kg m or kg m^2;
-        # |h| for one row) and reaches that same value at rank loss, so |H_bm^+| <= 5 / sigma_min(theta_0).
-        # sigma_min, not the norm: a 6-row coupling mixes kg m and kg m^2 rows and its sigma_min is
-        # far below its norm (boom7: 0.034 vs 6), where a norm-based threshold would damp every step.
+        # |h| for one row) and reaches that same value at rank loss, so |H_bm^+| <= 10 / sigma_min(theta_0)
+        # (sigma / (sigma^2 + lambda^2) peaks just below that). sigma_min, not the norm: a 6-row coupling
+        # mixes kg m and kg m^2 rows, its sigma_min far below its norm (boom7: 0.034 vs 6).
         q0 = model.q(model.spec.default_configuration)
         scale = float(np.linalg.svd(model.coupling_matrix(q0), compute_uv=False)[-1])
         self.threshold = singular_threshold if singular_threshold is not None else 0.1 * max(scale, 1e-9)
         self.max_damping = self.threshold
 
     def __call__(self, q: np.ndarray, v: np.ndarray) -> Coupling:
-        m, rows = self.model.m, self._rows
         M, c, hbm_dot = self.model.dynamics(q, v)
-        H_bm = M[rows, m:]
-        if self._single_row:  # closed form with floats (TREP, the 3R)
-            row_pinv, sigma, _ = damped_row_inverse(H_bm[0], self.threshold, self.max_damping)
-            inverse = (row_pinv, None, sigma)
-        else:
-            H_bm_pinv, sigma, _ = damped_pinv(H_bm, self.threshold, self.max_damping)
-            inverse = (None, H_bm_pinv, sigma)
-        return Coupling(M, c, hbm_dot, H_bm, inverse, q, v, rows, self._H_b_index)
+        H_bm = M[self._rows, self.model.m :]
+        inverse = damped_pinv(H_bm, self.threshold, self.max_damping)
+        return Coupling(M, c, hbm_dot, H_bm, inverse, q, v, self._rows, self._H_b_index)
 
 
 def realize_acceleration(
@@ -235,31 +226,34 @@ def realize_acceleration(
     x_b' (no knowledge of external forces): H_b x_b'' = -K_b x_b - D_b x_b' - c_b - H_bm theta'';
     the arm rows of Eq. (1) then give tau = H_bm^T x_b'' + H_m theta'' + c_m + D_m theta'.
     """
+    if model.m == 1:
+        return _one_dof_base_torques(model, cp, q, v, thetaddot)
+    return _any_base_torques(model, cp, q, v, thetaddot)
+
+
+def _any_base_torques(
+    model: FsmsModel, cp: Coupling, q: np.ndarray, v: np.ndarray, thetaddot: np.ndarray
+) -> np.ndarray:
+    """:func:`realize_acceleration` for an m-DOF base, as written there."""
     m, M, c = model.m, cp.M, cp.c
-    if m == 1:  # scalars for a 1-DOF base
-        h = M[0, 1:]
-        rhs = -model.K_b[0, 0] * q[0] - model.D_b[0, 0] * v[0] - c[0] - h.dot(thetaddot)
-        tau = h * (rhs / M[0, 0]) + cp.H_m.dot(thetaddot) + c[1:]
-    else:
-        rhs = -model.K_b @ q[:m] - model.D_b @ v[:m] - c[:m] - M[:m, m:] @ thetaddot
-        tau = M[:m, m:].T @ np.linalg.solve(M[:m, :m], rhs) + cp.H_m @ thetaddot + c[m:]
+    rhs = -model.K_b @ q[:m] - model.D_b @ v[:m] - c[:m] - M[:m, m:] @ thetaddot
+    tau = M[:m, m:].T @ np.linalg.solve(M[:m, :m], rhs) + M[m:, m:] @ thetaddot + c[m:]
     if model.has_joint_damping:
         tau += model.D_m @ v[m:]
     return tau
 
 
-def suppression_acceleration(cp: Coupling, g_b: float) -> np.ndarray:
-    """H_bm^+ (H_b G_b x_b' - H_bm' theta'): the vibration-suppression part of Eq. (15)."""
-    return cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot)
-
-
-def range_acceleration(cp: Coupling, g_b: float, g_m: float) -> np.ndarray:
-    """H_bm^+ (H_b G_b x_b' - H_bm' theta' - G_m L): the part of theta'' in Eq. (15) outside the RNS.
-
-    G_b = g_b E, G_m = g_m E. The -G_m L term is the law's -G_m (E - P) theta', because
-    (E - P) theta' = H_bm^+ H_bm theta' = H_bm^+ L (Eqs. 8, 9), also with the damped inverse.
-    """
-    if cp.row_pinv is not None:  # one coupling row: a scalar times the inverse column
-        H_b, xdot_b, hbm_dot_thetadot, L = cp.row_terms()
-        return cp.row_pinv * (g_b * H_b * xdot_b - hbm_dot_thetadot - g_m * L)
-    return cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum)
+def _one_dof_base_torques(
+    model: FsmsModel, cp: Coupling, q: np.ndarray, v: np.ndarray, thetaddot: np.ndarray
+) -> np.ndarray:
+    """:func:`realize_acceleration` for a 1-DOF base: x_b'' as a number, then the arm rows of Eq. (1)
+    as one product M_arm (x_b'', theta'') (fewer numpy calls than blocks, whatever n)."""
+    M, c = cp.M, cp.c
+    spring = -model.K_b.item(0) * q.item(0) - model.D_b.item(0) * v.item(0)
+    acceleration = np.empty(len(q))
+    acceleration[0] = (spring - c.item(0) - M[0, 1:].dot(thetaddot)) / M.item(0, 0)
+    acceleration[1:] = thetaddot
+    tau = M[1:] @ acceleration + c[1:]
+    if model.has_joint_damping:
+        tau += model.D_m @ v[1:]
+    return tau

@@ -32,7 +32,7 @@ from rns_viz.control.null_input import TaskReference
 from rns_viz.control.reference import ReferenceSample, TaskSample
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import quintic
-from rns_viz.rns import DampedInverse, damped_pinv, damping_squared
+from rns_viz.rns import damped_pinv
 
 LIMIT_MARGIN = math.radians(30.0)  # rad: the limit term of the avoidance measure acts this close to a limit
 
@@ -61,25 +61,6 @@ class TaskCircle:
         xdot = r * dphi * np.array([-si, c])
         xddot = r * ddphi * np.array([-si, c]) - r * dphi**2 * np.array([c, si])
         return x, xdot, xddot
-
-
-def _damped_inverse(A: np.ndarray, threshold: float) -> DampedInverse:
-    """:func:`~rns_viz.rns.damped_pinv` of A, by the closed form of the 2 x 2 Gram matrix for two rows.
-
-    sigma_min^2 is the smaller eigenvalue of A A^T; each numpy SVD of a small matrix costs more
-    than this whole arithmetic (a planar task arm's J_1 is 2 x k at every step).
-    """
-    if A.shape[0] != 2:
-        return damped_pinv(A, threshold, threshold)
-    (a, b), (_, c) = (A @ A.T).tolist()
-    half_trace, det = 0.5 * (a + c), a * c - b * b
-    sigma2 = max(half_trace - math.sqrt(max(half_trace * half_trace - det, 0.0)), 0.0)
-    sigma = math.sqrt(sigma2)
-    lam2 = damping_squared(sigma, threshold, threshold)
-    a, c = a + lam2, c + lam2
-    det = a * c - b * b
-    inverse = A.T @ np.array([[c, -b], [-b, a]]) / det
-    return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 
 class CompensatingLaw:
@@ -161,7 +142,7 @@ class CompensatingLaw:
         J1 = J[:p, self.task]
         e = x_d - ee[model.task_rows][:p]
         edot = xdot_d - J[:p] @ v[model.m :]
-        inv = _damped_inverse(J1, self.jacobian_threshold)
+        inv = damped_pinv(J1, self.jacobian_threshold, self.jacobian_threshold)  # two rows: a closed form
         acc = inv.inverse @ (xddot_d + self.gains.G_d * edot + self.gains.G_p * e - Jdot_thetadot[:p])
         if J1.shape[1] > p:  # a redundant task arm: damp its self-motion (E - J_1^+ J_1)
             w = v[model.m + self.task]

@@ -42,7 +42,7 @@ class JointServo:
         thetaddot = thetaddot_r + g.k_d * (thetadot_r - cp.thetadot) + g.k_p * (theta_r - cp.theta)
         return ControlOutput(
             tau=realize_acceleration(self.model, cp, q, v, thetaddot),
-            coupling_momentum=cp.H_bm @ cp.thetadot,
+            coupling_momentum=cp.coupling_momentum,
             sigma_hbm=cp.sigma,
             theta_ref=theta_r,
         )

@@ -1,7 +1,8 @@
 """Null-space inputs P_RNS u for the composite laws (12)/(15)/(16): what the arm does in the RNS.
 
-Each returns the joint acceleration P u (rad/s^2), which by Eq. (14) never reaches the base.
-Which of them the native step also computes is listed, by exact type, in rns_viz.sim.native.
+Each gives the joint acceleration P u (rad/s^2), which by Eq. (14) never reaches the base: u for
+the law to project, or P u itself (Eq. 24). Which of them the native step also computes is listed,
+by exact type, in rns_viz.sim.native.
 """
 
 from __future__ import annotations
@@ -20,10 +21,21 @@ from rns_viz.rns import damped_pinv
 
 @dataclass
 class NullOutput:
-    Pu: np.ndarray  # (n,) rad/s^2
+    """A null-space input, P_RNS (u - damping theta') + Pu: ``u`` and ``damping`` for the law to project,
+    ``Pu`` already in the RNS (Eq. 24). The law projects, so a one-row coupling needs no P_RNS formed."""
+
+    Pu: np.ndarray | None = None  # (n,) rad/s^2, already in the RNS
     sigma_jbar: float = float("nan")
     theta_ref: np.ndarray | None = None
     ee_ref: np.ndarray | None = None
+    u: np.ndarray | None = None  # (n,) rad/s^2, to be projected
+    damping: float = 0.0  # 1/s: -damping theta' joins u
+
+    def in_rns(self, cp: Coupling) -> np.ndarray:
+        """The whole input as a joint acceleration in the RNS, rad/s^2."""
+        u = -self.damping * cp.thetadot if self.u is None else self.u - self.damping * cp.thetadot
+        Pu = cp.project(u)
+        return Pu if self.Pu is None else Pu + self.Pu
 
 
 class NullInput(Protocol):
@@ -49,7 +61,7 @@ class DampNullMotion:
     g_m: float  # 1/s
 
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
-        return NullOutput(-self.g_m * (cp.P @ cp.thetadot))
+        return NullOutput(damping=self.g_m)
 
     def retune(self, gains: Gains) -> None:
         self.g_m = gains.g_m
@@ -69,7 +81,7 @@ class TrackJointReference:
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
         theta_r, thetadot_r, thetaddot_r = self.reference(t)
         u = thetaddot_r + self.k_d * (thetadot_r - cp.thetadot) + self.k_p * (theta_r - cp.theta)
-        return NullOutput(cp.P @ u, theta_ref=theta_r)
+        return NullOutput(u=u, theta_ref=theta_r)
 
     def retune(self, gains: Gains) -> None:
         self.k_p, self.k_d = gains.k_p, gains.k_d

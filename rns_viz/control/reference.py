@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-import pinocchio as pin
 
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import QuinticSegment
@@ -109,9 +108,8 @@ class PathReference:
 
     def n(self, theta: np.ndarray) -> np.ndarray:
         """Null-space vector n(theta) (Eq. 27 generalised), kg m."""
-        m = self.model.m
-        self._q[m:] = theta
-        return null_vector(pin.crba(self.model.pin_model, self.data, self._q)[self.model.selected, m:])
+        self._q[self.model.m :] = theta
+        return null_vector(self.model.coupling_matrix(self._q, self.data))
 
     def _advance(self, t: float) -> None:
         if t < self._t - 1e-12:

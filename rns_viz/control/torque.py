@@ -29,11 +29,11 @@ class TorqueLaw(CompositeLaw):
         null = self.null_input(t, cp, q, v)
         c_b = cp.c[:m][self.model.selected]
         vib = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - c_b)
-        arm = null.Pu - self.gains.g_m * (cp.thetadot - cp.P @ cp.thetadot)
+        arm = null.in_rns(cp) - self.gains.g_m * (cp.thetadot - cp.project(cp.thetadot))
         tau = cp.H_m @ (vib + arm) + cp.c[m:] + self.model.D_m @ cp.thetadot
         return ControlOutput(
             tau=tau,
-            coupling_momentum=cp.H_bm @ cp.thetadot,
+            coupling_momentum=cp.coupling_momentum,
             sigma_hbm=cp.sigma,
             sigma_jbar=null.sigma_jbar,
             theta_ref=null.theta_ref,

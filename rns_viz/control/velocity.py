@@ -2,9 +2,10 @@
 
 theta'_cmd = H_bm^+ H_b g_b x_b + g_m (theta_ref - theta)       [+ theta_ref' if feedforward]
 
-Read with the base deflection x_b, not its rate: integrating (29) with constant H_bm^+ turns
-H_bm^+ m_b g_b x_b' into H_bm^+ m_b g_b x_b (DESIGN.md section 3); only this form has
-consistent units and damps. m_b is H_b, the base inertia of Eq. (1). theta_ref is the path
+Read with the base deflection x_b, not its rate: (30) is (29) integrated once in time with
+H_bm^+ held constant, and the integral of (29)'s term H_bm^+ m_b g_b x_b' is H_bm^+ m_b g_b x_b.
+Printed with x_b', the term would have units of rad/s^2 in a velocity command; with x_b it has
+rad/s, and damps. m_b is H_b, the base inertia of Eq. (1). theta_ref is the path
 integral of n u-bar (PathReference), a fixed configuration, or any joint reference.
 
 The servo: the motor drivers of TREP take velocity commands; we model them as a velocity loop
@@ -73,7 +74,7 @@ class VelocityLaw:
         tau = realize_acceleration(self.model, cp, q, v, thetaddot)
         return ControlOutput(
             tau=tau,
-            coupling_momentum=cp.H_bm @ cp.thetadot,
+            coupling_momentum=cp.coupling_momentum,
             sigma_hbm=cp.sigma,
             theta_ref=theta_r,
             extra={f"thetadot_cmd_{i + 1}": float(c) for i, c in enumerate(cmd)},
