@@ -230,7 +230,7 @@ class OwnArithmetic(TrackJointReference):
 
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
         out = super().__call__(t, cp, q, v)
-        out.Pu = 0.5 * out.Pu
+        out.u = 0.5 * out.u  # type: ignore[operator]
         return out
 
 
