@@ -214,26 +214,13 @@ class Renderer:
     # ---------------------------------------------------------------- the panel
     def _update_plots(self, snap: Snapshot) -> None:
         version = self.session.plots.version
-        if version == self._seen.plot_version:
+        if self.gui.plots.mode != self._seen.plot_mode:  # the other scale's charts: send them data now
+            self._seen.plot_mode = self.gui.plots.mode
+        elif version == self._seen.plot_version:
             return
         self._seen.plot_version = version
-        a = self.session.plot_arrays()
-        t = a["t"]
-        if len(t) < 2 or not np.all(np.isfinite(t)):
-            return
-        g = self.gui
-
-        def clean(x: np.ndarray) -> np.ndarray:  # no NaN or inf ever reaches a plot
-            return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
-
-        g.plot_xb.data = (t, clean(a["xb"]), clean(a["xb_shadow"]))
-        g.plot_L.data = (t, clean(a["L"]), clean(a["L_shadow"]))
-        g.plot_error.data = (t, clean(a["ee_error"]))
-        self.plot_updates += 1
-        titles = _plot_titles(snap)
-        if titles != self._seen.titles:
-            self._seen.titles = titles
-            g.plot_xb.title, g.plot_L.title = titles
+        if self.gui.plots.update(self.session.plot_arrays()):
+            self.plot_updates += 1
 
     def _update_text(self, snap: Snapshot) -> None:
         g = self.gui
@@ -298,11 +285,4 @@ class _Seen:
         self.plot_version = -1
         self.next_plot = 0.0
         self.next_text = 0.0
-        self.titles: tuple[str, str] = ("", "")
-
-
-def _plot_titles(snap: Snapshot) -> tuple[str, str]:
-    st = snap.settings
-    on, off = ("ON", "OFF") if st.suppress else ("OFF", "ON")
-    which = f"operated: suppression {on}" + (f", shadow: {off}" if st.shadow else "")
-    return f"Base deflection ({which})", f"Coupling momentum ({which})"
+        self.plot_mode = ""
