@@ -97,8 +97,8 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
     gui.main_panel.dock_right()
     status = gui.add_html("")
     gui.add_markdown(
-        "**Try:** *Kick the base* with suppression on and off and compare the two curves below; "
-        "drag the **green handle** in the scene; load a paper experiment under *Paper presets*."
+        "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
+        "drag the **green handle**."
     )
     with gui.add_folder("Operate"):
         kick = gui.add_button("Kick the base", icon=viser.Icon.HAND_FINGER, color="red")
@@ -120,18 +120,12 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         reset = gui.add_button(
             "Reset", icon=viser.Icon.REFRESH, hint="Back to the start (of the preset, if one is loaded)."
         )
-        speed = gui.add_dropdown(
-            "Speed",
-            tuple(SPEED_LABELS[s] for s in SPEEDS),
-            initial_value="1×",
-            hint="Simulated seconds per wall-clock second.",
-        )
     with gui.add_folder("Paper presets"):
-        gui.add_markdown("One click loads an experiment's law, gains, motion and kicks (and its model).")
-        presets_trep = gui.add_button_group("TREP", TREP_PRESETS)
-        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS)
+        hint = "One click loads an experiment's law, gains, motion and kicks (and its model)."
+        presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=hint)
+        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=hint)
         preset_paused = gui.add_checkbox(
-            "Start presets paused",
+            "Start paused",
             True,
             hint="A preset waits at t = 0 for Resume, so its kick and motion happen with the plots in view.",
         )
@@ -200,6 +194,12 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             initial_value=EXAGGERATION[model],
             hint="The base deflection is drawn this many times larger than simulated.",
         )
+        speed = gui.add_dropdown(
+            "Speed",
+            tuple(SPEED_LABELS[s] for s in SPEEDS),
+            initial_value="1×",
+            hint="Simulated seconds per wall-clock second.",
+        )
         shadow = gui.add_checkbox(
             "Shadow run", True, hint="A second simulation with the same inputs and suppression the other way."
         )
@@ -243,4 +243,4 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**Loaded: {name}** — {SCENARIOS[name].description}. Reset restarts it."
+    return f"**{name}**: {SCENARIOS[name].description}. Reset restarts it."

@@ -18,6 +18,8 @@ import numpy as np
 import viser
 import viser.uplot
 
+from rns_viz.viz.units import si
+
 ON_COLOUR, OFF_COLOUR, ERROR_COLOUR = "#1f6fd1", "#e0503a", "#2a9d4b"
 SCALES = {"linear": "linear, fits the data", "symlog": "symmetric log, fixed range"}
 # Display units: x_b in µm and L in mN·s (= g·m/s) keep tick labels readable from the 3R's
@@ -27,20 +29,6 @@ L_MNS_PER_SI = 1e3
 # symmetric-log charts: fixed range and linear threshold (uPlot distr 4, asinh), display units
 XB_SYMLOG = (1e5, 0.1)  # ±100 mm, linear below 0.1 µm
 L_SYMLOG = (1e4, 1e-3)  # ±10 kg·m/s, linear below 1 µN·s
-_PREFIXES = ((1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, ""), (1e3, "k"))
-
-
-def si(value: float, unit: str) -> str:
-    """``value`` (SI) with an SI prefix and three significant digits: si(2.1e-6, "m") == "2.10 µm"."""
-    if not math.isfinite(value):
-        return "—"
-    if value == 0.0:
-        return f"0 {unit}"
-    scale, prefix = _PREFIXES[0]
-    for s, p in _PREFIXES:
-        if abs(value) >= s:
-            scale, prefix = s, p
-    return f"{value / scale:.3g} {prefix}{unit}"
 
 
 def peak(x: np.ndarray) -> float:
@@ -69,7 +57,7 @@ def _chart(
         axes=({"label": "t (s)"}, {"label": y_label, "size": 64}),
         legend={"show": True, "live": False},
         cursor={"show": False},
-        aspect=2.4,
+        aspect=2.6,
         padding=(8, 24, 0, 0),
     )
 
@@ -81,13 +69,6 @@ class LivePlots:
     """The charts, the scale choice and the peaks table; :meth:`update` sends new data."""
 
     def __init__(self, gui: viser.GuiApi) -> None:
-        self.scale = gui.add_dropdown(
-            "Plot scale",
-            tuple(SCALES.values()),
-            initial_value=SCALES["linear"],
-            hint="Symmetric log: the same fixed axes for every preset, so micrometres look small next to "
-            "millimetres (fig11-fast against fig11-joint2).",
-        )
         linear: viser.uplot.Scale = {"auto": True}
         self.charts: dict[str, dict[str, viser.GuiUplotHandle]] = {}
         for mode in SCALES:
@@ -101,6 +82,13 @@ class LivePlots:
             }
         self.error = _chart(gui, "End-effector error", "|e| (mm)", (("|x_ref − x_e|", ERROR_COLOUR),), linear)
         self.peaks = gui.add_html(peaks_html(None))
+        self.scale = gui.add_dropdown(
+            "Plot scale",
+            tuple(SCALES.values()),
+            initial_value=SCALES["linear"],
+            hint="Symmetric log: the same fixed axes for every preset, so micrometres look small next to "
+            "millimetres (fig11-fast against fig11-joint2).",
+        )
         self.mode = "linear"
         self.show_mode("linear")
 
