@@ -86,9 +86,9 @@ def run_preset(page: Page, app: RnsApp, name: str) -> None:
     assert_curves(page, app, s.snapshot().t, name)
 
 
-def shoot(page: Page, name: str) -> None:
-    # the panel scrolled to Operate: kick, presets and plots on one 900 px screen
-    page.get_by_text("Operate", exact=True).evaluate("e => e.scrollIntoView({block: 'start'})")
+def shoot(page: Page, name: str, top: str = "Operate") -> None:
+    """A screenshot with the panel scrolled to ``top`` (Operate: kick, presets and plots on one screen)."""
+    page.get_by_text(top, exact=True).evaluate("e => e.scrollIntoView({block: 'start'})")
     page.mouse.move(5, 5)
     dismiss_notifications(page)
     wait_for_frames(page, 10)
@@ -110,6 +110,12 @@ def test_every_preset_fills_the_plots_and_fig11_shows_the_contrast(app: RnsApp) 
                 page.set_viewport_size({"width": 800, "height": 900})
                 shoot(page, f"plots_{name}_800")
                 page.set_viewport_size({"width": 1400, "height": 900})
+                app.gui.plots.scale.value = SCALES["symlog"]  # runs the dropdown's callback
+                wait_until(lambda: app.gui.plots.mode == "symlog", 10.0, "the symmetric-log charts")
+                assert_curves(page, app, s.snapshot().t, f"{name}, symmetric log")
+                shoot(page, f"plots_{name}_symlog_1400", "Live plots (last 10 s)")
+                app.gui.plots.scale.value = SCALES["linear"]
+                wait_until(lambda: app.gui.plots.mode == "linear", 10.0, "the linear charts")
         # The paper's Fig. 11: the same end points in joint space move the base ~500x more (m, SI).
         assert peaks["fig11-joint2"] > 100.0 * peaks["fig11-fast"], peaks
         # fig10-off runs with suppression off: its shadow is the "on" curve, the same kick (first swing)
@@ -121,9 +127,3 @@ def test_every_preset_fills_the_plots_and_fig11_shows_the_contrast(app: RnsApp) 
         s.kick(5.0)
         s.advance(RUN_S)
         assert_curves(page, app, s.snapshot().t, "planar3r after a switch")
-
-        # The symmetric-log charts: fixed axes, the same curves.
-        app.gui.plots.scale.value = SCALES["symlog"]
-        wait_until(lambda: app.gui.plots.mode == "symlog", 10.0, "the symmetric-log charts")
-        s.advance(0.5)
-        assert_curves(page, app, s.snapshot().t, "the symmetric-log charts")

@@ -54,11 +54,13 @@ def _chart(
         series=tuple(series),
         title=title,
         scales={"x": {"time": False, "auto": True}, "y": y_scale},
-        axes=({"label": "t (s)"}, {"label": y_label, "size": 64}),
+        # px; time in s (the legend's first entry); a log axis draws no tick marks (uPlot packs the
+        # negative half's minor ones into a solid bar)
+        axes=({"size": 28}, {"label": y_label, "size": 64, "ticks": {"show": y_scale.get("distr") != 4}}),
         legend={"show": True, "live": False},
         cursor={"show": False},
-        aspect=2.6,
-        padding=(8, 24, 0, 0),
+        aspect=1.9,
+        padding=(4, 16, 0, 0),
     )
 
 
