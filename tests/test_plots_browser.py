@@ -127,3 +127,37 @@ def test_every_preset_fills_the_plots_and_fig11_shows_the_contrast(app: RnsApp) 
         s.kick(5.0)
         s.advance(RUN_S)
         assert_curves(page, app, s.snapshot().t, "planar3r after a switch")
+
+
+def test_views_follow_presets_and_notices_reach_the_page(app: RnsApp) -> None:
+    """After a preset the path slider is disabled at 0 and no old path stays lit; a path motion asked
+    for while the path is computed waits with a notice and then runs; a target off the path is moved
+    with a notice (TREP)."""
+    s, g = app.session, app.gui
+    with browser_page(app.server, width=1400, height=900) as page:
+        dismiss_notifications(page)
+        assert s.wait_background()  # the default path
+        s.advance(0.1)
+        wait_until(lambda: not g.sigma.disabled and app.scene.paths.visible, 10.0, "the live path and slider")
+        g.sigma.value = 20.0  # scrub along the path: the slider holds a value of the live path
+        wait_until(lambda: "Scrub" in s.pending_commands(), 10.0, "the scrub")
+        s.advance(1.0)
+        run_preset(page, app, "fig11-fast")
+        wait_until(lambda: g.sigma.disabled and g.sigma.value == 0.0, 10.0, "the path slider to rest at 0")
+        assert s.snapshot().target is None
+
+        # Play slowly while the path through the preset's configuration is still being computed.
+        page.get_by_role("button", name="Play path slowly").first.click()
+        wait_until(lambda: "Play" in s.pending_commands(), 10.0, "the play command")
+        s.advance(0.0)
+        wait_until(lambda: page.get_by_text("Waiting for the path").count() > 0, 10.0, "the waiting notice")
+        assert s.wait_background()
+        s.advance(1.0)
+        assert "path" in s.snapshot().mode and s.snapshot().settings.preset is None
+        wait_until(lambda: not g.sigma.disabled, 10.0, "the slider on the new path")
+
+        # A target far off the reactionless path is moved onto it, and the page says so.
+        client_id = next(iter(app.server.get_clients()))
+        s.set_target((0.0, -0.3), final=True, client=client_id)
+        s.advance(0.01)
+        wait_until(lambda: page.get_by_text("Target moved").count() > 0, 10.0, "the 'Target moved' notice")
