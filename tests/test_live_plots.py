@@ -11,10 +11,11 @@ import pytest
 
 from rns_viz.live.plots import PLOT_SERIES
 from rns_viz.live.session import Session
-from rns_viz.viz.app import start_app
+from rns_viz.viz.app import IDLE_RESTART_S, start_app
 from rns_viz.viz.live_plots import on_off, peaks_html
 from rns_viz.viz.units import si
-from tests.browser import wait_until
+from tests.browser import wait_for_clients, wait_until
+from tests.protocol_client import ProtocolClient
 
 
 def test_si_prefixes_and_zeros() -> None:
@@ -104,3 +105,24 @@ def test_a_preset_can_start_paused() -> None:
         assert s.snapshot().t == pytest.approx(0.5)
     finally:
         s.stop()
+
+
+def test_a_session_nobody_watched_restarts_for_its_first_visitor(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert IDLE_RESTART_S == 60.0
+    monkeypatch.setattr("rns_viz.viz.app.IDLE_RESTART_S", 1.0)  # s: the test runs 2 s, not 61
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    try:
+        s = app.session
+        s.advance(2.0)
+        first = ProtocolClient(app.port)
+        wait_for_clients(app, 1, "the first visitor")
+        wait_until(lambda: "Reset" in s.pending_commands(), 10.0, "the restart")
+        s.advance(0.5)
+        second = ProtocolClient(app.port)  # a second tab while someone watches: nothing restarts
+        wait_for_clients(app, 2, "the second visitor")
+        s.advance(0.0)
+        assert s.snapshot().t == pytest.approx(0.5) and "Reset" not in s.pending_commands()
+        first.close()
+        second.close()
+    finally:
+        app.stop()
