@@ -59,7 +59,7 @@ def _chart(
         axes=({"size": 28}, {"label": y_label, "size": 64, "ticks": {"show": y_scale.get("distr") != 4}}),
         legend={"show": True, "live": False},
         cursor={"show": False},
-        aspect=1.9,
+        aspect=2.1,
         padding=(4, 16, 0, 0),
     )
 
