@@ -313,8 +313,11 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
         assert snap.settings.preset == "fig10-on" and snap.settings.law == "velocity"
         assert snap.settings.gains.g_b == 24.0 and snap.settings.gains.g_m == 20.0 and snap.settings.suppress
         wait_until(lambda: app.gui.gains["g_m"].value == 20.0, 5.0, "the g_m slider to show the preset")
+        assert snap.paused and snap.t == 0.0  # "Start presets paused": it waits for Resume
+        s.resume()
         s.advance(1.0)  # the preset's kick comes at 0.5 s
         assert peak_xb(s, 1.0) > 1e-3
+        app.gui.preset_paused.value = False  # this one starts at once
         app.gui.presets_3r.value = "fig3"  # a 3R preset switches the model
         queued(app, "LoadPreset")
         s.advance(0.0)

@@ -208,6 +208,7 @@ class SwitchModel(Command):
 @dataclass(frozen=True)
 class LoadPreset(Command):
     name: str
+    paused: bool = False  # adopt it paused at t = 0 (the operator resumes once the plots are in view)
 
     def __post_init__(self) -> None:
         if self.name not in SCENARIOS:

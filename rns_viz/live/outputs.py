@@ -51,8 +51,11 @@ class Outputs:
         if model is not None and q is not None:
             self._update_readouts(model, q)
 
-    def after_step(self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool) -> None:
-        """Book one step of the operated run (``model`` is the loop's own instance for kinematics)."""
+    def after_step(
+        self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool, suppress: bool = True
+    ) -> None:
+        """Book one step of the operated run (``model`` is the loop's own instance for kinematics;
+        ``suppress``: the operated run has suppression on, so the shadow has it off)."""
         self.steps += 1
         dt = runs.sim.dt
         L = float(out.coupling_momentum[0])
@@ -61,11 +64,13 @@ class Outputs:
         self.reaction += (force - self.reaction) * min(1.0, dt / REACTION_TAU)
         self.last = out
         if self.steps % PLOT_EVERY == 0:
-            self._sample_plots(model, runs, out, shadow_on)
+            self._sample_plots(model, runs, out, shadow_on, suppress)
         if self.steps % READOUT_EVERY == 0:
             self._update_readouts(model, runs.sim.q)
 
-    def _sample_plots(self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool) -> None:
+    def _sample_plots(
+        self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool, suppress: bool
+    ) -> None:
         sim, shadow = runs.sim, runs.shadow
         x = model.ee_position(sim.q[model.m :])[:2]
         ref = reference_point(model, out)
@@ -79,6 +84,7 @@ class Outputs:
                 L_of(out),
                 L_of(shadow_out) if shadow_out is not None else math.nan,
                 self.ee_error * 1e3,
+                float(suppress),
             )
         )
 

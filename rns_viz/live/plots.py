@@ -6,7 +6,8 @@ import threading
 
 import numpy as np
 
-PLOT_SERIES = ("t", "xb", "xb_shadow", "L", "L_shadow", "ee_error")
+# "suppress" is 1.0 while the operated run had suppression on (the shadow had it off), else 0.0
+PLOT_SERIES = ("t", "xb", "xb_shadow", "L", "L_shadow", "ee_error", "suppress")
 
 
 class PlotBuffers:

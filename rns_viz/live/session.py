@@ -182,8 +182,9 @@ class Session:
     def switch_model(self, name: str, client: int | None = None) -> None:
         self.send(c.SwitchModel(name, client=client))
 
-    def load_preset(self, name: str, client: int | None = None) -> None:
-        self.send(c.LoadPreset(name, client=client))
+    def load_preset(self, name: str, client: int | None = None, paused: bool = False) -> None:
+        """Build preset ``name`` off the loop and adopt it at t = 0 (``paused``: waiting for Resume)."""
+        self.send(c.LoadPreset(name, paused=paused, client=client))
 
     def start_lesson(self, model: str, number: int, client: int | None = None) -> None:
         """Lesson ``number`` (1-based) of ``model``: loads its state; the snapshot reports its progress."""

@@ -55,6 +55,7 @@ class LiveState:
         self.lesson: LessonRun | None = None
         self.kicks_sent = 0  # kicks since the session started (lessons count them)
         self.targets_moved = 0  # dragged targets moved onto the path / into the set (lessons count them)
+        self._preset_paused = False  # the preset being built starts paused
         self.start_live(model)
 
     # ================================================================ set-up
@@ -142,6 +143,7 @@ class LiveState:
             preset=name,
         )
         self._restart_bookkeeping()
+        self.paused = self._preset_paused
         self._request_geometry(runs.theta)
         self._overlays_changed()
 
@@ -168,11 +170,8 @@ class LiveState:
 
     # ================================================================ commands
     def apply(self, cmd: c.Command) -> None:
-        """Apply one command; InputRefused/ValueError leave everything as it was and tell the sender.
-
-        A path motion asked for while the current path is still being computed waits for it (the
-        latest such input wins) and runs when the path arrives.
-        """
+        """Apply one command; InputRefused/ValueError leave everything as it was and tell the sender. A path
+        motion asked for while the path is being computed waits for it (the latest wins) and runs then."""
         try:
             self._apply(cmd)
         except PathNotReady:
@@ -213,6 +212,9 @@ class LiveState:
                 self.explorer.kicked(self.runs.t)
             case c.SetSuppression(on=on):
                 self.runs.set_suppression(on)
+                if on != st.suppress:  # the runs swap roles: both, and the plots, restart from here
+                    self.runs.resync_shadow()
+                    self.outputs.plots.clear()
                 self.settings = replace(st, suppress=on)
             case c.SetLaw(law=law):
                 self._gain_memory[(st.model, st.law)] = st.gains
@@ -263,7 +265,8 @@ class LiveState:
                 self.lesson = lesson
             case c.StopLesson():
                 self.lesson = None
-            case c.LoadPreset(name=name):
+            case c.LoadPreset(name=name, paused=paused):
+                self._preset_paused = paused
                 self.background.preset(self.epoch, name)
                 self.notify("Loading preset", f"{name}: {SCENARIOS[name].description}", cmd.client, "info")
             case _:
@@ -300,7 +303,7 @@ class LiveState:
             self.fail(f"the simulation diverged at t = {t:.3f} s ({exc})")
             return False
         assert out is not None
-        self.outputs.after_step(self.model, runs, out, shadow_on)
+        self.outputs.after_step(self.model, runs, out, shadow_on, self.settings.suppress)
         k = self.outputs.steps
         if k % GUARD_EVERY == 0 and self._out_of_bounds():
             return False

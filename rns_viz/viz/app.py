@@ -27,6 +27,8 @@ from rns_viz.viz.inputs import Controls
 from rns_viz.viz.render import TARGET_HANDLE, Renderer
 from rns_viz.viz.scene import FsmsScene
 
+IDLE_RESTART_S = 60.0  # s of simulated time: a session older than this restarts for its first visitor
+
 
 class RnsApp:
     """The GUI and scene of one session on one viser server."""
@@ -39,7 +41,7 @@ class RnsApp:
         self.gui: GuiElements = make_gui(server, session.snapshot().settings.model)
         self.controls = Controls(self.gui, session, self.connections)
         self.renderer = Renderer(server, session, self.gui, self.controls, self.connections)
-        server.on_client_connect(self.connections.client_joined)
+        server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
     @property
@@ -93,6 +95,13 @@ class RnsApp:
         self.renderer.stop()
         self.session.stop()
         self.server.stop()
+
+    def _client_joined(self, client: viser.ClientHandle) -> None:
+        """Register the client; the first visitor of an unwatched session that ran on for a while gets
+        it from the start (not "t = 4365 s" of a kick nobody saw)."""
+        self.connections.client_joined(client)
+        if self.connections.client_count() == 1 and self.session.snapshot().t > IDLE_RESTART_S:
+            self.session.reset()
 
     def _client_left(self, client: viser.ClientHandle) -> None:
         """End the client's drag while it still counts as the operator, then pass control on."""

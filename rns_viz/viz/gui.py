@@ -1,9 +1,9 @@
 """The app's control panel: every GUI element, built once by :func:`make_gui`.
 
-Layout, top to bottom: a status line; *Operate* (kick, suppression, run controls); *Readouts*;
-*Live plots*; *Reactionless path* (TREP) or *Target* (planar 3R); *Control law and gains*;
-*Paper presets*; *Model and view*; *Log*. Labels carry units; hints explain the symbols.
-Model-specific elements are shown or hidden by the app.
+Layout, top to bottom (kick, presets and plots fit one 900 px screen): a status line; *Operate*
+(kick, suppression, run controls); *Paper presets*; *Live plots*; *Readouts*; *Reactionless path*
+(TREP) or *Target* (planar 3R); *Control law and gains*; *Model and view*; *Log*.
+Labels carry units; hints explain the symbols. Model-specific elements are shown or hidden by the app.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
 from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, SCENARIOS
+from rns_viz.viz.live_plots import LivePlots
 
 MODEL_LABELS = {"trep": "TREP (2R on a flexible beam)", "planar3r": "planar 3R on a spring"}
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
@@ -50,8 +51,6 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ("k_d", "k_d (1/s)", 0.0, 200.0, 0.5, "Joint-reference damping inside the reaction null space (TREP, laws 15/16)."),
 )
 
-PLOT_COLOURS = ("#1f6fd1", "#e0503a", "#2a9d4b")
-
 
 @dataclass
 class GuiElements:
@@ -66,7 +65,8 @@ class GuiElements:
     reset: viser.GuiButtonHandle
     speed: viser.GuiDropdownHandle
     readouts: viser.GuiHtmlHandle
-    plot_xb: viser.GuiUplotHandle
+    plots: LivePlots
+    plot_xb: viser.GuiUplotHandle  # the linear charts of ``plots``
     plot_L: viser.GuiUplotHandle
     plot_error: viser.GuiUplotHandle
     path_folder: viser.GuiFolderHandle
@@ -82,29 +82,12 @@ class GuiElements:
     gains: dict[str, viser.GuiSliderHandle]
     presets_trep: viser.GuiButtonGroupHandle
     presets_3r: viser.GuiButtonGroupHandle
+    preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
     exaggeration: viser.GuiSliderHandle
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
-
-
-def _plot(gui: viser.GuiApi, title: str, y_label: str, labels: tuple[str, ...]) -> viser.GuiUplotHandle:
-    import numpy as np
-
-    empty = tuple(np.zeros(2) for _ in range(len(labels) + 1))
-    series: list[viser.uplot.Series] = [{"label": "t (s)"}]
-    series += [{"label": label, "stroke": PLOT_COLOURS[i], "width": 1.5} for i, label in enumerate(labels)]
-    return gui.add_uplot(
-        data=empty,
-        series=tuple(series),
-        title=title,
-        scales={"x": {"time": False, "auto": True}, "y": {"auto": True}},
-        axes=({"label": "t (s)"}, {"label": y_label, "size": 60}),
-        legend={"show": True, "live": False},
-        cursor={"show": False},
-        aspect=1.9,
-    )
 
 
 def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
@@ -114,8 +97,8 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
     gui.main_panel.dock_right()
     status = gui.add_html("")
     gui.add_markdown(
-        "**Try:** *Kick the base* with suppression on and off and compare the two curves below; "
-        "drag the **green handle** in the scene; load a paper experiment under *Paper presets*."
+        "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
+        "drag the **green handle**."
     )
     with gui.add_folder("Operate"):
         kick = gui.add_button("Kick the base", icon=viser.Icon.HAND_FINGER, color="red")
@@ -137,26 +120,20 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         reset = gui.add_button(
             "Reset", icon=viser.Icon.REFRESH, hint="Back to the start (of the preset, if one is loaded)."
         )
-        exaggeration = gui.add_slider(
-            "Deflection drawn ×",
-            min=1.0,
-            max=100.0,
-            step=1.0,
-            initial_value=EXAGGERATION[model],
-            hint="The base deflection is drawn this many times larger than simulated.",
+    with gui.add_folder("Paper presets"):
+        hint = "One click loads an experiment's law, gains, motion and kicks (and its model)."
+        presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=hint)
+        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=hint)
+        preset_paused = gui.add_checkbox(
+            "Start paused",
+            True,
+            hint="A preset waits at t = 0 for Resume, so its kick and motion happen with the plots in view.",
         )
-        speed = gui.add_dropdown(
-            "Speed",
-            tuple(SPEED_LABELS[s] for s in SPEEDS),
-            initial_value="1×",
-            hint="Simulated seconds per wall-clock second.",
-        )
+        preset_info = gui.add_markdown("")
+    with gui.add_folder("Live plots (last 10 s)"):
+        plots = LivePlots(gui)
     with gui.add_folder("Readouts"):
         readouts = gui.add_html("")
-    with gui.add_folder("Live plots (last 10 s)"):
-        plot_xb = _plot(gui, "Base deflection", "x_b (mm)", ("as operated", "shadow"))
-        plot_L = _plot(gui, "Coupling momentum", "L (kg·m/s)", ("as operated", "shadow"))
-        plot_error = _plot(gui, "End-effector tracking error", "|e| (mm)", ("|x_ref − x_e|",))
     with gui.add_folder("Reactionless path (TREP)") as path_folder:
         gui.add_markdown(
             "Drag the **green handle** in the scene: the end effector moves along its current reactionless "
@@ -207,13 +184,22 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             name: gui.add_slider(label, min=lo, max=hi, step=step, initial_value=lo, hint=hint)
             for name, label, lo, hi, step, hint in GAIN_SLIDERS
         }
-    with gui.add_folder("Paper presets", expand_by_default=False):
-        gui.add_markdown("One click loads the experiment's law, gains, motion and kicks (and switches model).")
-        presets_trep = gui.add_button_group("TREP", TREP_PRESETS)
-        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS)
-        preset_info = gui.add_markdown("")
     with gui.add_folder("Model and view", expand_by_default=False):
         model_dd = gui.add_dropdown("Model", tuple(MODEL_LABELS.values()), initial_value=MODEL_LABELS[model])
+        exaggeration = gui.add_slider(
+            "Deflection drawn ×",
+            min=1.0,
+            max=100.0,
+            step=1.0,
+            initial_value=EXAGGERATION[model],
+            hint="The base deflection is drawn this many times larger than simulated.",
+        )
+        speed = gui.add_dropdown(
+            "Speed",
+            tuple(SPEED_LABELS[s] for s in SPEEDS),
+            initial_value="1×",
+            hint="Simulated seconds per wall-clock second.",
+        )
         shadow = gui.add_checkbox(
             "Shadow run", True, hint="A second simulation with the same inputs and suppression the other way."
         )
@@ -228,9 +214,10 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         reset=reset,
         speed=speed,
         readouts=readouts,
-        plot_xb=plot_xb,
-        plot_L=plot_L,
-        plot_error=plot_error,
+        plots=plots,
+        plot_xb=plots.xb,
+        plot_L=plots.L,
+        plot_error=plots.error,
         path_folder=path_folder,
         sigma=sigma,
         play_slow=play_slow,
@@ -244,6 +231,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         gains=gains,
         presets_trep=presets_trep,
         presets_3r=presets_3r,
+        preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
         exaggeration=exaggeration,
@@ -255,4 +243,4 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**Loaded: {name}** — {SCENARIOS[name].description}. Reset restarts it."
+    return f"**{name}**: {SCENARIOS[name].description}. Reset restarts it."

@@ -24,12 +24,14 @@ from rns_viz.live.session import Session
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gui import MODEL_LABELS, SPEED_LABELS, GuiElements
 from rns_viz.viz.input_check import check_value
+from rns_viz.viz.live_plots import SCALES
 
 REFUSAL_REPEAT_S = 2.0  # s: a watcher dragging the handle is told at most this often
 
 _LAW_OF_LABEL = {v: k for k, v in LAW_LABELS.items()}
 _MODEL_OF_LABEL = {v: k for k, v in MODEL_LABELS.items()}
 _SPEED_OF_LABEL = {v: k for k, v in SPEED_LABELS.items()}
+_SCALE_OF_LABEL = {v: k for k, v in SCALES.items()}
 
 Act = Callable[[Any, int | None], None]  # act(value, client_id)
 
@@ -146,8 +148,10 @@ class Controls:
         self._on_input(g.law, lambda v, c: s.set_law(_LAW_OF_LABEL[v], c))
         for name, slider in g.gains.items():
             self._on_input(slider, lambda v, c, name=name: s.set_gains(c, **{name: float(v)}))
-        self._on_input(g.presets_trep, lambda v, c: s.load_preset(v, c), button=True)
-        self._on_input(g.presets_3r, lambda v, c: s.load_preset(v, c), button=True)
+        self._on_input(g.preset_paused, lambda v, c: None)  # read at the next preset
+        for group in (g.presets_trep, g.presets_3r):
+            self._on_input(group, lambda v, c: s.load_preset(v, c, bool(self.good(g.preset_paused))), button=True)
+        self._on_input(g.plots.scale, lambda v, c: g.plots.show_mode(_SCALE_OF_LABEL[v]))
         self._on_input(g.model, lambda v, c: s.switch_model(_MODEL_OF_LABEL[v], c))
         self._on_input(g.shadow, lambda v, c: s.set_shadow(bool(v), c))
         g.download.on_click(self._on_download)

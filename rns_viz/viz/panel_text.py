@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from rns_viz.live.records import Snapshot
+from rns_viz.viz.units import si
 
 OK_COLOUR = "#1b7f3b"
 WARN_COLOUR = "#c77700"
@@ -54,8 +55,7 @@ def readouts_html(snap: Snapshot) -> str:
         n = "(" + ", ".join(f"{v:+.3g}" for v in r.n) + ") kg·m"
     else:
         n = f"{r.rns_dim}-D null space (no single n)"
-    err = "–" if not math.isfinite(r.ee_error) else f"{r.ee_error * 1e3:.3g} mm"
-    x_b = snap.q[0] * 1e3
+    err = si(r.ee_error, "m", floor=1e-9)
     rows = [
         (
             "σ<sub>min</sub>(H<sub>bm</sub>)",
@@ -64,10 +64,10 @@ def readouts_html(snap: Snapshot) -> str:
         ),
         ("σ(J̄)", _value(r.sigma_jbar, r.warn_jbar, "m/rad"), "distance to singularity of J̄ = J P<sub>RNS</sub>"),
         ("n", n, "null-space vector, Eq. (27)"),
-        ("L = H<sub>bm</sub>θ̇", f"{r.L:+.3g} kg·m/s", "coupling momentum, Eq. (8)"),
-        ("x<sub>b</sub>", f"{x_b:+.4f} mm", "base deflection"),
+        ("L = H<sub>bm</sub>θ̇", si(r.L, "N·s", 1e-9, True), "coupling momentum, Eq. (8); 1 N·s = 1 kg·m/s"),
+        ("x<sub>b</sub>", si(float(snap.q[0]), "m", 1e-9, True), "base deflection"),
         ("end-effector error", err, "|x<sub>ref</sub> − x<sub>e</sub>|"),
-        ("reaction on base", f"{r.reaction:+.3g} N", "red arrow: −dL/dt, the arm's push on the base"),
+        ("reaction on base", si(r.reaction, "N", 1e-6, True), "red arrow: −dL/dt, the arm's push on the base"),
     ]
     body = "".join(
         f'<tr title="{hint}"><td style="padding-right:8px">{name}</td><td>{value}</td></tr>'

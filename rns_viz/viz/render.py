@@ -209,31 +209,20 @@ class Renderer:
             curves.append(ov.current)
         if curves:
             self.scene.set_path_family(curves, len(curves) - 1 if ov.current is not None else None)
+        else:  # no family and no current path (yet): the last model's or preset's must not stay lit
+            self.scene.paths.visible = False
         self.scene.set_reachable_set(ov.reach)
 
     # ---------------------------------------------------------------- the panel
     def _update_plots(self, snap: Snapshot) -> None:
         version = self.session.plots.version
-        if version == self._seen.plot_version:
+        if self.gui.plots.mode != self._seen.plot_mode:  # the other scale's charts: send them data now
+            self._seen.plot_mode = self.gui.plots.mode
+        elif version == self._seen.plot_version:
             return
         self._seen.plot_version = version
-        a = self.session.plot_arrays()
-        t = a["t"]
-        if len(t) < 2 or not np.all(np.isfinite(t)):
-            return
-        g = self.gui
-
-        def clean(x: np.ndarray) -> np.ndarray:  # no NaN or inf ever reaches a plot
-            return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
-
-        g.plot_xb.data = (t, clean(a["xb"]), clean(a["xb_shadow"]))
-        g.plot_L.data = (t, clean(a["L"]), clean(a["L_shadow"]))
-        g.plot_error.data = (t, clean(a["ee_error"]))
-        self.plot_updates += 1
-        titles = _plot_titles(snap)
-        if titles != self._seen.titles:
-            self._seen.titles = titles
-            g.plot_xb.title, g.plot_L.title = titles
+        if self.gui.plots.update(self.session.plot_arrays()):
+            self.plot_updates += 1
 
     def _update_text(self, snap: Snapshot) -> None:
         g = self.gui
@@ -255,12 +244,35 @@ class Renderer:
         cyclic_label = "Stop cyclic motion" if snap.mode.startswith("cyclic") else "Start cyclic motion"
         if g.cyclic.label != cyclic_label:
             g.cyclic.label = cyclic_label
-        if snap.sigma_range is not None and np.all(np.isfinite(snap.sigma_range)):
-            lo, hi = snap.sigma_range
-            if (g.sigma.min, g.sigma.max) != (round(lo, 1), round(hi, 1)):
-                g.sigma.min, g.sigma.max = round(lo, 1), round(hi, 1)
-            if snap.sigma is not None and np.isfinite(snap.sigma) and "scrub" not in snap.mode:
-                self.controls.show(g.sigma, float(np.clip(round(snap.sigma, 1), g.sigma.min, g.sigma.max)))
+        self._show_path_position(snap)
+        self._handle_follows(snap)
+
+    def _handle_follows(self, snap: Snapshot) -> None:
+        """While a preset runs its own motion (no target) the handle stays on the end effector."""
+        if snap.settings.preset is None or snap.target is not None or not np.all(np.isfinite(snap.q)):
+            return
+        home = self._home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
+        if np.linalg.norm(home - np.asarray(self.handle.position)) > 0.5 * self.scene.style.marker_radius:
+            self.handle.position = home
+
+    def _show_path_position(self, snap: Snapshot) -> None:
+        """The path slider: its range and position on the current path; disabled at 0 while there is
+        none (a preset runs its own motion, or the path is still being computed)."""
+        g = self.gui
+        known = snap.sigma_range is not None and np.all(np.isfinite(snap.sigma_range))
+        known = known and snap.sigma is not None and np.isfinite(snap.sigma)
+        if g.sigma.disabled != (not known):
+            g.sigma.disabled = not known
+        if not known:
+            if g.sigma.min <= 0.0 <= g.sigma.max:
+                self.controls.show(g.sigma, 0.0)
+            return
+        assert snap.sigma_range is not None and snap.sigma is not None
+        lo, hi = snap.sigma_range
+        if (g.sigma.min, g.sigma.max) != (round(lo, 1), round(hi, 1)):
+            g.sigma.min, g.sigma.max = round(lo, 1), round(hi, 1)
+        if "scrub" not in snap.mode:
+            self.controls.show(g.sigma, float(np.clip(round(snap.sigma, 1), g.sigma.min, g.sigma.max)))
 
     def sync_settings(self, snap: Snapshot) -> None:
         """Show the settings in force (after presets, law switches, model switches, refused input)."""
@@ -298,11 +310,4 @@ class _Seen:
         self.plot_version = -1
         self.next_plot = 0.0
         self.next_text = 0.0
-        self.titles: tuple[str, str] = ("", "")
-
-
-def _plot_titles(snap: Snapshot) -> tuple[str, str]:
-    st = snap.settings
-    on, off = ("ON", "OFF") if st.suppress else ("OFF", "ON")
-    which = f"operated: suppression {on}" + (f", shadow: {off}" if st.shadow else "")
-    return f"Base deflection ({which})", f"Coupling momentum ({which})"
+        self.plot_mode = ""

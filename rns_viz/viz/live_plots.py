@@ -1,0 +1,162 @@
+"""The live plots: base deflection, coupling momentum and tracking error, and each curve's peak.
+
+Every chart's options (title, series, scales, axes) are fixed when it is built: viser's uPlot
+component rebuilds a chart whose options change, and when that rebuild lands in the same browser
+frame as new data it keeps the destroyed chart's x range as a *relative* zoom, which pins the time
+axis far outside the data (e.g. 50-150 s) in every tab until a reload. So nothing but data is ever
+sent to a chart; the meaning of the colours is fixed (blue: suppression on, red: off, whichever run
+is operated), the y scale is chosen by showing one of two prebuilt charts (a new chart mounts
+fresh), and the peaks are HTML beside them.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+import viser
+import viser.uplot
+
+from rns_viz.viz.units import si
+
+ON_COLOUR, OFF_COLOUR, ERROR_COLOUR = "#1f6fd1", "#e0503a", "#2a9d4b"
+SCALES = {"linear": "linear, fits the data", "symlog": "symmetric log, fixed range"}
+# Display units: x_b in µm and L in mN·s (= g·m/s) keep tick labels readable from the 3R's
+# centimetres down to fig11-fast's micrometres; the error in mm.
+XB_UM_PER_MM = 1e3  # the plot buffers carry x_b in mm
+L_MNS_PER_SI = 1e3
+# symmetric-log charts: fixed range and linear threshold (uPlot distr 4, asinh), display units
+XB_SYMLOG = (1e5, 0.1)  # ±100 mm, linear below 0.1 µm
+L_SYMLOG = (1e4, 1e-3)  # ±10 kg·m/s, linear below 1 µN·s
+
+
+def peak(x: np.ndarray) -> float:
+    """Largest magnitude of the finite samples, NaN if there are none."""
+    x = x[np.isfinite(x)]
+    return float(np.max(np.abs(x))) if len(x) else math.nan
+
+
+def on_off(arrays: dict[str, np.ndarray], key: str) -> tuple[np.ndarray, np.ndarray]:
+    """Series ``key`` of the run with suppression on and of the run with it off, sample by sample."""
+    on = arrays["suppress"] > 0.5
+    ours, shadow = arrays[key], arrays[f"{key}_shadow"]
+    return np.where(on, ours, shadow), np.where(on, shadow, ours)
+
+
+def _chart(
+    gui: viser.GuiApi, title: str, y_label: str, curves: tuple[tuple[str, str], ...], y_scale: viser.uplot.Scale
+) -> viser.GuiUplotHandle:
+    series: list[viser.uplot.Series] = [{"label": "t (s)"}]
+    series += [{"label": label, "stroke": colour, "width": 1.5} for label, colour in curves]
+    return gui.add_uplot(
+        data=tuple(np.zeros(2) for _ in range(len(curves) + 1)),
+        series=tuple(series),
+        title=title,
+        scales={"x": {"time": False, "auto": True}, "y": y_scale},
+        # px; time in s (the legend's first entry); a log axis draws no tick marks (uPlot packs the
+        # negative half's minor ones into a solid bar)
+        axes=({"size": 28}, {"label": y_label, "size": 64, "ticks": {"show": y_scale.get("distr") != 4}}),
+        legend={"show": True, "live": False},
+        cursor={"show": False},
+        aspect=2.1,
+        padding=(4, 16, 0, 0),
+    )
+
+
+ON_OFF = (("suppression on", ON_COLOUR), ("suppression off", OFF_COLOUR))
+
+
+class LivePlots:
+    """The charts, the scale choice and the peaks table; :meth:`update` sends new data."""
+
+    def __init__(self, gui: viser.GuiApi) -> None:
+        linear: viser.uplot.Scale = {"auto": True}
+        self.charts: dict[str, dict[str, viser.GuiUplotHandle]] = {}
+        for mode in SCALES:
+            xb_scale, L_scale = linear, linear
+            if mode == "symlog":
+                xb_scale = {"auto": False, "distr": 4, "asinh": XB_SYMLOG[1], "range": (-XB_SYMLOG[0], XB_SYMLOG[0])}
+                L_scale = {"auto": False, "distr": 4, "asinh": L_SYMLOG[1], "range": (-L_SYMLOG[0], L_SYMLOG[0])}
+            self.charts[mode] = {
+                "xb": _chart(gui, "Base deflection", "x_b (µm)", ON_OFF, xb_scale),
+                "L": _chart(gui, "Coupling momentum", "L (mN·s)", ON_OFF, L_scale),
+            }
+        self.error = _chart(gui, "End-effector error", "|e| (mm)", (("|x_ref − x_e|", ERROR_COLOUR),), linear)
+        self.peaks = gui.add_html(peaks_html(None))
+        self.scale = gui.add_dropdown(
+            "Plot scale",
+            tuple(SCALES.values()),
+            initial_value=SCALES["linear"],
+            hint="Symmetric log: the same fixed axes for every preset, so micrometres look small next to "
+            "millimetres (fig11-fast against fig11-joint2).",
+        )
+        self.mode = "linear"
+        self.show_mode("linear")
+
+    @property
+    def xb(self) -> viser.GuiUplotHandle:
+        return self.charts["linear"]["xb"]
+
+    @property
+    def L(self) -> viser.GuiUplotHandle:
+        return self.charts["linear"]["L"]
+
+    def show_mode(self, mode: str) -> None:
+        """Show the charts of scale ``mode`` (a hidden chart unmounts; shown again it mounts fresh)."""
+        self.mode = mode
+        for name, charts in self.charts.items():
+            for chart in charts.values():
+                chart.visible = name == mode
+
+    def update(self, arrays: dict[str, np.ndarray]) -> bool:
+        """Send the arrays (PLOT_SERIES of the session) to the shown charts; False if too few samples."""
+        t = arrays["t"]
+        if len(t) < 2 or not np.all(np.isfinite(t)):
+            return False
+        xb_on, xb_off = on_off(arrays, "xb")
+        L_on, L_off = on_off(arrays, "L")
+        shown = self.charts[self.mode]
+        shown["xb"].data = (t, _clean(xb_on * XB_UM_PER_MM), _clean(xb_off * XB_UM_PER_MM))
+        shown["L"].data = (t, _clean(L_on * L_MNS_PER_SI), _clean(L_off * L_MNS_PER_SI))
+        self.error.data = (t, _clean(arrays["ee_error"]))
+        e = peak(arrays["ee_error"]) * 1e-3  # m, the operated run's
+        content = peaks_html(
+            {
+                "xb": (peak(xb_on) * 1e-3, peak(xb_off) * 1e-3),
+                "L": (peak(L_on), peak(L_off)),
+                "e": (e, math.nan) if arrays["suppress"][-1] > 0.5 else (math.nan, e),
+            }
+        )
+        if self.peaks.content != content:
+            self.peaks.content = content
+        return True
+
+
+def _clean(x: np.ndarray) -> np.ndarray:
+    """No NaN or inf ever reaches a chart (a missing shadow run is drawn at 0)."""
+    return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
+
+
+_ROWS = (("xb", "|x_b|", "m"), ("L", "|L|", "N·s"), ("e", "|e|", "m"))
+
+
+def peaks_html(peaks: dict[str, tuple[float, float]] | None) -> str:
+    """The peak of every curve over the plotted window (SI values in ``data-si`` for tests and tools)."""
+    head = (
+        f'<tr><th style="text-align:left">peak, last 10 s</th><th style="color:{ON_COLOUR}">suppression on</th>'
+        f'<th style="color:{OFF_COLOUR}">suppression off</th></tr>'
+    )
+    rows = []
+    for key, label, unit in _ROWS:
+        on, off = peaks[key] if peaks is not None else (math.nan, math.nan)
+        cells = "".join(
+            f'<td data-peak="{key}-{side}" data-si="{v!r}" style="text-align:right">{html.escape(si(v, unit))}</td>'
+            for side, v in (("on", on), ("off", off))
+        )
+        rows.append(f"<tr><td>{html.escape(label)}</td>{cells}</tr>")
+    note = "|e|: the operated run. Blue is always suppression on, red off; the other run is the shadow run."
+    return (
+        '<table style="font-size:0.8em;width:100%">' + head + "".join(rows) + "</table>"
+        f'<div style="font-size:0.75em;opacity:0.75">{note}</div>'
+    )
