@@ -26,6 +26,7 @@ from rns_viz.viz.gui import GuiElements, make_gui
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.render import TARGET_HANDLE, Renderer
 from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.view_toggles import make_view_toggles
 
 
 class RnsApp:
@@ -38,7 +39,8 @@ class RnsApp:
         self.connections = Connections(server, password)
         self.gui: GuiElements = make_gui(server, session.snapshot().settings.model)
         self.controls = Controls(self.gui, session, self.connections)
-        self.renderer = Renderer(server, session, self.gui, self.controls, self.connections)
+        self.view = make_view_toggles(server, self.connections)
+        self.renderer = Renderer(server, session, self.gui, self.controls, self.connections, self.view)
         server.on_client_connect(self.connections.client_joined)
         server.on_client_disconnect(self._client_left)
 

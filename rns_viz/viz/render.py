@@ -32,6 +32,8 @@ from rns_viz.viz.gui import (
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.panel_text import readouts_html, status_html
 from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.teach_scene import TeachScene
+from rns_viz.viz.view_toggles import ViewToggles
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
@@ -52,8 +54,10 @@ class Renderer:
         gui: GuiElements,
         controls: Controls,
         connections: Connections,
+        view: ViewToggles | None = None,
     ) -> None:
         self.server = server
+        self.view = view or ViewToggles({})
         self.session = session
         self.gui = gui
         self.controls = controls
@@ -81,6 +85,8 @@ class Renderer:
         self.model = FsmsModel.from_name(snap.settings.model)  # drawing only (its own pinocchio data)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
         self._reach = arm_reach(self.model)
+        self.teach = TeachScene(self.server, self.model, self.scene)
+        self.teach.reaction_label = REACTION_LABEL
         st = self.scene.style
         self.handle = self.server.scene.add_transform_controls(
             TARGET_HANDLE,
@@ -138,6 +144,9 @@ class Renderer:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
         self._draw_state(snap)
+        exaggeration = float(self.controls.good(self.gui.exaggeration))
+        q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
+        self.teach.draw(snap, q_shadow, exaggeration, self.view)
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
             self._draw_overlays()
@@ -169,7 +178,8 @@ class Renderer:
             seen.q, seen.exaggeration = q, exaggeration
             with self.server.atomic():
                 self.scene.update(q, exaggeration)
-                self.scene.set_reaction_force(self._drawn_force(snap.readouts.reaction), REACTION_LABEL)
+                f = snap.readouts.reaction  # N, exactly the readout's (Eq. 1); the label shows 3 digits
+                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, REACTION_LABEL)
             self.scene_updates += 1
 
     def _draw_target(self, snap: Snapshot) -> None:
@@ -196,12 +206,6 @@ class Renderer:
         out[:m] = np.clip(np.round(q[:m] / quantum) * quantum, -10.0, 10.0)
         return out
 
-    def _drawn_force(self, f: float) -> float:
-        """The reaction force rounded to 4 % of the longest arrow (N): smaller changes are not drawn."""
-        st = self.scene.style
-        quantum = 0.04 * st.force_arrow_max / st.force_scale
-        return round(f / quantum) * quantum if np.isfinite(f) else 0.0
-
     def _draw_overlays(self) -> None:
         ov = self.session.overlays()
         curves = list(ov.family or [])
@@ -210,6 +214,8 @@ class Renderer:
         if curves:
             self.scene.set_path_family(curves, len(curves) - 1 if ov.current is not None else None)
         self.scene.set_reachable_set(ov.reach)
+        self.teach.has_reach = ov.reach is not None and len(ov.reach) > 0
+        self.teach.set_path(ov.current)
 
     # ---------------------------------------------------------------- the panel
     def _update_plots(self, snap: Snapshot) -> None:
