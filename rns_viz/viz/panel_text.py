@@ -67,7 +67,11 @@ def readouts_html(snap: Snapshot) -> str:
         ("L = H<sub>bm</sub>θ̇", f"{r.L:+.3g} kg·m/s", "coupling momentum, Eq. (8)"),
         ("x<sub>b</sub>", f"{x_b:+.4f} mm", "base deflection"),
         ("end-effector error", err, "|x<sub>ref</sub> − x<sub>e</sub>|"),
-        ("reaction on base", f"{r.reaction:+.3g} N", "red arrow: −dL/dt, the arm's push on the base"),
+        (
+            "reaction on base",
+            f"{r.reaction:+.3g} N",
+            "red arrow: −(H_bm θ'' + c_b), Eq. (1): the arm's push on the base",
+        ),
     ]
     body = "".join(
         f'<tr title="{hint}"><td style="padding-right:8px">{name}</td><td>{value}</td></tr>'

@@ -1,0 +1,121 @@
+"""Issue 11, the app's teaching views: the ghost draws the shadow run, the reaction force is Eq. (1)'s.
+
+The reaction is checked against an independent evaluation of Eq. (1) from the step log (pinocchio's
+CRBA and RNEA, a linear solve, no ABA); the ghost against the shadow simulation's own state.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from rns_viz.live.session import Session
+from rns_viz.model import FsmsModel
+from rns_viz.viz.app import RnsApp, start_app
+from tests.browser import wait_until
+
+
+def independent_reaction(model: FsmsModel, row: dict[str, np.ndarray]) -> float:
+    """−(H_bm θ'' + c_b) of Eq. (1) with θ'' from M a = u − c solved directly (not the plant's ABA)."""
+    m, pm = model.m, model.pin_model
+    data = pm.createData()
+    q, v = row["q"], row["v"]
+    M = pin.crba(pm, data, q)
+    M = np.triu(M) + np.triu(M, 1).T
+    c = pin.rnea(pm, data, q, v, np.zeros(model.nv))  # velocity terms (zero gravity)
+    u = np.concatenate([-model.K_b @ q[:m] - model.D_b @ v[:m] + row["f"], row["tau"] - model.D_m @ v[m:]])
+    a = np.linalg.solve(M, u - c)
+    return float(-(M[:m, m:] @ a[m:] + c[:m])[model.selected[0]])
+
+
+def log_row(s: Session, t: float) -> dict[str, np.ndarray]:
+    sim = s.state.runs.sim
+    m, n = sim.model.m, sim.model.n
+    log = sim.log
+    k = int(np.flatnonzero(log.column("t") == t)[0])
+    arr = log.array()[k]
+    col = log.index
+    get = lambda prefix, count: np.array([arr[col[f"{prefix}_{i + 1}"]] for i in range(count)])  # noqa: E731
+    return {
+        "q": np.concatenate([get("xb", m), get("theta", n)]),
+        "v": np.concatenate([get("xbdot", m), get("thetadot", n)]),
+        "tau": get("tau", n),
+        "f": get("fext", m),
+    }
+
+
+@pytest.mark.parametrize(
+    ("model", "peak", "motion"),
+    [("trep", 0.8, "play_fast"), ("planar3r", 5.0, None)],
+)
+def test_reaction_readout_is_eq1_at_its_step(model: str, peak: float, motion: str | None) -> None:
+    s = Session(model, realtime=False)
+    try:
+        assert s.wait_background()
+        if motion is not None:
+            getattr(s, motion)()
+        s.advance(0.05)
+        s.kick(peak)
+        worst, biggest = 0.0, 0.0
+        for _ in range(12):  # during the kick (f_ext != 0) and after it
+            s.advance(0.021)
+            r = s.snapshot().readouts
+            assert np.isfinite(r.reaction_t)
+            expected = independent_reaction(s.state.runs.sim.model, log_row(s, r.reaction_t))
+            worst = max(worst, abs(r.reaction - expected))
+            biggest = max(biggest, abs(expected))
+        assert biggest > 1e-3  # N: the arm does push on the base here
+        assert worst < 1e-9, f"readout differs from Eq. (1) by {worst:.3g} N (largest force {biggest:.3g} N)"
+    finally:
+        s.stop()
+
+
+@pytest.fixture
+def trep_app() -> Iterator[RnsApp]:
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    assert app.session.wait_background()
+    yield app
+    app.stop()
+
+
+def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp) -> None:
+    app, s = trep_app, trep_app.session
+    assert s.snapshot().settings.suppress
+    s.kick(0.8)
+    s.advance(0.6)  # suppression on: the operated base settles, the shadow's keeps swinging
+    shadow, operated = s.state.runs.shadow.q.copy(), s.state.runs.sim.q.copy()
+    assert abs(shadow[0] - operated[0]) > 1e-4  # m: the two runs differ by more than the drawing's rounding
+    ghost = app.renderer.teach.ghost
+    wait_until(lambda: ghost.q is not None and abs(ghost.q[0] - shadow[0]) < 1e-5, 5.0, "the ghost to be drawn")
+    assert ghost.q is not None
+    np.testing.assert_allclose(ghost.q, shadow, atol=1e-4)
+    # The drawn base node (exaggerated) sits where the shadow's x_b puts it, not the operated one's.
+    ex = ghost.exaggeration
+    drawing = FsmsModel.from_name("trep")
+    base = pin.SE3(drawing.pin_model.jointPlacements[1])
+    expected = base.translation + ex * shadow[0] * (base.rotation @ drawing.base_axes()[0])
+    np.testing.assert_allclose(ghost.drawn_base_position(), expected, atol=2e-4 * ex)
+    assert np.linalg.norm(ghost.drawn_base_position() - expected) < ex * abs(shadow[0] - operated[0])
+    # Hidden with its checkbox.
+    app.view.boxes["ghost"].value = False
+    wait_until(lambda: not ghost.root.visible, 5.0, "the ghost to hide")
+
+
+def test_drawn_n_and_force_are_the_models(trep_app: RnsApp) -> None:
+    app, s = trep_app, trep_app.session
+    s.play_fast()
+    s.advance(0.4)
+    snap = s.snapshot()
+    teach = app.renderer.teach
+    theta = np.round(snap.q[1:], 4)
+    wait_until(lambda: teach._theta is not None and np.array_equal(teach._theta, theta), 5.0, "n to be drawn")
+    model = FsmsModel.from_name("trep")
+    H = model.coupling_matrix(model.q(theta))
+    assert teach.n is not None and abs(float((H @ teach.n)[0])) < 1e-12  # kg m/s per unit u-bar: no coupling
+    np.testing.assert_allclose(teach.n, [H[0, 1], -H[0, 0]], rtol=1e-12)  # Eq. (27)
+    time.sleep(0.1)
+    assert app.scene._force == s.snapshot().readouts.reaction  # the arrow is the readout, unrounded
