@@ -119,3 +119,53 @@ def test_drawn_n_and_force_are_the_models(trep_app: RnsApp) -> None:
     np.testing.assert_allclose(teach.n, [H[0, 1], -H[0, 0]], rtol=1e-12)  # Eq. (27)
     time.sleep(0.1)
     assert app.scene._force == s.snapshot().readouts.reaction  # the arrow is the readout, unrounded
+
+
+def test_lesson_panel_starts_steps_and_shows_progress_through_the_protocol() -> None:
+    from tests.browser import wait_for_clients
+    from tests.protocol_client import ProtocolClient, gui_uuid
+
+    app = start_app("trep", port=0, realtime=False, verbose=False, lesson=1)
+    try:
+        s = app.session
+        s.advance(0.01)
+        assert s.wait_background()
+        wait_until(lambda: "Lesson 1 of 6" in app.lessons.text.content, 5.0, "lesson 1 in the panel")
+        assert "✓" not in app.lessons.text.content and "Eq. (1)" in app.lessons.text.content
+        with ProtocolClient(app.port, decode=True) as ws:
+            wait_for_clients(app, 1, "the websocket client to connect")
+            s.kick(0.8)
+            s.advance(3.5)  # the student's task of lesson 1: kick and watch it swing
+            wait_until(lambda: "✓" in app.lessons.text.content, 5.0, "the tick of a finished lesson")
+            ws.click(gui_uuid(app.lessons.next))
+            wait_until(lambda: "StartLesson" in s.pending_commands(), 10.0, "Next to queue a lesson")
+            s.advance(0.05)
+            lesson = s.snapshot().lesson
+            assert lesson is not None and lesson.number == 2 and not lesson.done
+            wait_until(lambda: "Lesson 2 of 6" in app.lessons.text.content, 5.0, "lesson 2 in the panel")
+            ws.set_value(gui_uuid(app.lessons.chooser), "3R 2. The reactionless-reachable set")
+            wait_until(lambda: app.lessons.chooser.value.startswith("3R 2"), 5.0, "the chooser's new value")
+            ws.click(gui_uuid(app.lessons.start))
+            wait_until(lambda: "StartLesson" in s.pending_commands(), 10.0, "Start to queue a lesson")
+            s.advance(0.05)
+            lesson = s.snapshot().lesson
+            assert lesson is not None and (lesson.model, lesson.number) == ("planar3r", 2)
+            assert s.snapshot().settings.model == "planar3r"
+            ws.click(gui_uuid(app.lessons.stop))
+            wait_until(lambda: "StopLesson" in s.pending_commands(), 10.0, "Stop to queue")
+            s.advance(0.01)
+            assert s.snapshot().lesson is None
+    finally:
+        app.stop()
+
+
+def test_cli_lesson_option_reaches_the_app(monkeypatch: pytest.MonkeyPatch) -> None:
+    import rns_viz.viz.app as app_module
+    from rns_viz import cli
+
+    calls: list[dict[str, object]] = []
+    monkeypatch.setattr(app_module, "serve", lambda **kw: calls.append(kw))
+    assert cli.main(["--lesson", "2"]) == 0
+    assert cli.main(["serve", "--model", "planar3r", "--lesson", "3", "--port", "0"]) == 0
+    assert [(c["model"], c["lesson"]) for c in calls] == [("trep", 2), ("planar3r", 3)]
+    assert cli.main(["serve", "--model", "planar3r", "--lesson", "4"]) == 2  # the 3R has three lessons

@@ -10,6 +10,7 @@ from __future__ import annotations
 import threading
 import time
 import traceback
+from collections.abc import Callable
 
 import numpy as np
 import viser
@@ -58,6 +59,7 @@ class Renderer:
     ) -> None:
         self.server = server
         self.view = view or ViewToggles({})
+        self.text_panels: list[Callable[[Snapshot], None]] = []  # more panels refreshed with the text (5 Hz)
         self.session = session
         self.gui = gui
         self.controls = controls
@@ -248,6 +250,8 @@ class Renderer:
             g.status.content = status
         if g.readouts.content != readouts:
             g.readouts.content = readouts
+        for refresh in self.text_panels:
+            refresh(snap)
         pause_label = "Reset (diverged)" if snap.diverged else "Resume" if snap.paused else "Pause"
         if g.pause.label != pause_label:
             g.pause.label = pause_label
