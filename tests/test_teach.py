@@ -169,3 +169,22 @@ def test_cli_lesson_option_reaches_the_app(monkeypatch: pytest.MonkeyPatch) -> N
     assert cli.main(["serve", "--model", "planar3r", "--lesson", "3", "--port", "0"]) == 0
     assert [(c["model"], c["lesson"]) for c in calls] == [("trep", 2), ("planar3r", 3)]
     assert cli.main(["serve", "--model", "planar3r", "--lesson", "4"]) == 2  # the 3R has three lessons
+
+
+def test_path_words_turn_ubar_into_joint_angles_and_rates() -> None:
+    from rns_viz.viz.path_words import path_words
+
+    s = Session("trep", realtime=False)
+    try:
+        assert s.wait_background()
+        s.play_slow()
+        s.advance(1.0)
+        snap = s.snapshot()
+        text = path_words(snap)
+        n = snap.readouts.n
+        assert n is not None and snap.sigma is not None
+        assert f"joint 2 at **{np.degrees(snap.q[-1]):.1f}°**" in text
+        # theta' = n u-bar (Eq. 27): joint 2's rate at the chosen u-bar, deg/s
+        assert f"joint 2 {np.degrees(abs(n[1]) * snap.settings.ubar_speed):.0f}°/s" in text
+    finally:
+        s.stop()

@@ -11,6 +11,7 @@ import numpy as np
 import trimesh
 import viser
 
+from rns_viz.live.readouts import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.robot import RobotMeshes
@@ -49,8 +50,12 @@ class Ghost:
         assert root is not None
         self.root = root
         self.base_drawing = _ghost_base(server, model, style.base)
+        reach = arm_reach(model)  # m: the label sits back along the base, clear of the base's own label
         self.label = server.scene.add_label(
-            f"{self.BASE}/label", "shadow run", position=np.add(style.base_label, (0.0, 0.0, 0.03)), anchor="top-center"
+            f"{self.BASE}/label",
+            "shadow run",
+            position=np.add(style.base_label, (0.0, -0.6 * reach, 0.0)),
+            anchor="top-center",
         )
         self.q: np.ndarray | None = None  # the shadow's q as drawn (before exaggeration)
         self.exaggeration = float("nan")
