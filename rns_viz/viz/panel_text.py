@@ -60,13 +60,17 @@ def readouts_html(snap: Snapshot) -> str:
         (
             "σ<sub>min</sub>(H<sub>bm</sub>)",
             _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
-            "distance to singularity of the coupling",
+            "how much grip the arm has on the base; near 0 it can neither push nor damp it",
         ),
-        ("σ(J̄)", _value(r.sigma_jbar, r.warn_jbar, "m/rad"), "distance to singularity of J̄ = J P<sub>RNS</sub>"),
-        ("n", n, "null-space vector, Eq. (27)"),
-        ("L = H<sub>bm</sub>θ̇", f"{r.L:+.3g} kg·m/s", "coupling momentum, Eq. (8)"),
-        ("x<sub>b</sub>", f"{x_b:+.4f} mm", "base deflection"),
-        ("end-effector error", err, "|x<sub>ref</sub> − x<sub>e</sub>|"),
+        (
+            "σ(J̄)",
+            _value(r.sigma_jbar, r.warn_jbar, "m/rad"),
+            "how freely the hand can move without pushing the base (J̄ = J P<sub>RNS</sub>)",
+        ),
+        ("n", n, "the joint direction that pushes the base not at all (orange arrow: the hand's way), Eq. (27)"),
+        ("L = H<sub>bm</sub>θ̇", f"{r.L:+.3g} kg·m/s", "momentum the joints hand to the base (purple arrow), Eq. (8)"),
+        ("x<sub>b</sub>", f"{x_b:+.4f} mm", "how far the base is bent from rest"),
+        ("end-effector error", err, "how far the hand is from where the law sends it"),
         (
             "reaction on base",
             f"{r.reaction:+.3g} N",
