@@ -1,6 +1,7 @@
 """Issue 11 in a real headless Chromium: a student walks lesson 1 (kick the base, watch it swing) with
 the ghost of the shadow run shown. Screenshots: artifacts/lesson1_start.png, lesson1_done.png and
-ghost_trep.png (the base deflection drawn x50: the arm swings, the ghost with suppression has settled).
+ghost_trep.png (the base deflection drawn x50: the arm swings, the ghost with suppression has settled),
+and picture_trep.png, saved by the app's Save picture button.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from rns_viz.viz.ghost import Ghost
 from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.teach_scene import TeachScene
 from tests.browser import (
+    ARTIFACTS,
     browser_page,
     dismiss_notifications,
     local_position,
@@ -69,3 +71,11 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         dismiss_notifications(page)
         wait_for_frames(page, 20)
         assert screenshot(page, "lesson1_done").stat().st_size > 10_000
+
+        # Pictures: one button, a PNG of the scene rendered by the browser, downloaded.
+        with page.expect_download(timeout=60_000) as download:
+            page.get_by_role("button", name="Save picture (PNG)").click()
+        path = ARTIFACTS / "picture_trep.png"
+        download.value.save_as(path)
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
+        assert app.pictures.saved == 1
