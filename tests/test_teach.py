@@ -188,3 +188,26 @@ def test_path_words_turn_ubar_into_joint_angles_and_rates() -> None:
         assert f"joint 2 {np.degrees(abs(n[1]) * snap.settings.ubar_speed):.0f}°/s" in text
     finally:
         s.stop()
+
+
+def test_reachable_region_outline_is_its_edge() -> None:
+    app = start_app("planar3r", port=0, realtime=False, verbose=False)
+    try:
+        assert app.session.wait_background()
+        app.session.advance(0.01)
+        teach = app.renderer.teach
+        wait_until(lambda: teach.has_reach and teach.outline.visible, 10.0, "the region's outline")
+        reach = app.session.overlays().reach
+        assert reach is not None
+        edge = np.asarray(teach.outline.points, dtype=float)
+        d = np.sqrt(((edge[:, None, :2] - reach[None, :, :2]) ** 2).sum(axis=2))
+        span = float(np.ptp(reach[:, :2], axis=0).max())
+        assert d.min(axis=1).max() < 0.06 * span  # every outline point lies at the region
+        # ... and the region's extreme samples lie on the outline (it goes all the way round).
+        for k in (int(np.argmax(reach[:, 0])), int(np.argmin(reach[:, 0])), int(np.argmax(reach[:, 1]))):
+            assert np.sqrt(((edge[:, :2] - reach[k, :2]) ** 2).sum(axis=1)).min() < 0.06 * span
+        assert len(edge) < 0.1 * len(reach)  # an outline, not the region again
+        app.view.boxes["reach"].value = False
+        wait_until(lambda: not teach.outline.visible and not app.scene.reachable.visible, 5.0, "the region to hide")
+    finally:
+        app.stop()

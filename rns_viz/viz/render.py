@@ -216,7 +216,7 @@ class Renderer:
         if curves:
             self.scene.set_path_family(curves, len(curves) - 1 if ov.current is not None else None)
         self.scene.set_reachable_set(ov.reach)
-        self.teach.has_reach = ov.reach is not None and len(ov.reach) > 0
+        self.teach.set_reach(ov.reach)
         self.teach.set_path(ov.current)
 
     # ---------------------------------------------------------------- the panel

@@ -15,11 +15,13 @@ from rns_viz.live.records import Snapshot
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector
 from rns_viz.viz.ghost import Ghost
+from rns_viz.viz.region_outline import outline_points
 from rns_viz.viz.scene import PATH_HIGHLIGHT, FsmsScene
 from rns_viz.viz.view_toggles import ViewToggles
 
 L_COLOUR = (120, 40, 170)  # purple: coupling momentum
 N_COLOUR = (235, 130, 0)  # orange: null-space direction at the hand
+OUTLINE_COLOUR = (110, 60, 190)  # the reachable region's edge, darker than its dots
 PATH_ARROWS = 8  # arrowheads along the current path
 L_REF_RATE = 1.0  # rad/s: a joint rate that draws L at full arrow length (with sigma(H_bm) at the start)
 
@@ -30,6 +32,7 @@ class TeachScene:
     COUPLING = "/base/coupling"
     NULL = "/base/null_vector"
     PATH_ARROWS = "/base/path_arrows"
+    OUTLINE = "/base/reach_outline"
 
     def __init__(self, server: viser.ViserServer, model: FsmsModel, scene: FsmsScene) -> None:
         self.server, self.model, self.scene = server, model, scene
@@ -51,6 +54,18 @@ class TeachScene:
             head_length=1.5 * r,
             position=(0.0, 0.0, st.overlay_z),
             visible=False,
+        )
+        self.outline = server.scene.add_point_cloud(
+            self.OUTLINE,
+            np.zeros((1, 3)),
+            OUTLINE_COLOUR,
+            point_size=0.6 * r,
+            point_shape="circle",
+            position=(0.0, 0.0, st.overlay_z - 0.5 * r),  # just above the region's dots
+            visible=False,
+        )
+        self.outline_label = server.scene.add_label(
+            f"{self.OUTLINE}/label", "edge of the reactionless region: a fold, J̄ loses rank", visible=False
         )
         self._has_path = False
         self.has_reach = False  # the reachable set is drawn (set by the renderer with the overlays)
@@ -98,6 +113,7 @@ class TeachScene:
         if view.on("reach") != sc.show_reach:
             sc.show_reach = view.on("reach")
             sc.reachable.visible = sc.show_reach and self.has_reach
+            self.outline.visible = self.outline_label.visible = sc.show_reach and self.has_reach
 
     def _draw_coupling(self, L: float | None) -> None:
         if L is None or not np.isfinite(L):
@@ -144,6 +160,19 @@ class TeachScene:
             self.null.visible = self.null_label.visible = True
 
     # ---------------------------------------------------------------- overlays
+    def set_reach(self, points: np.ndarray | None) -> None:
+        """The outline of the reactionless-reachable region (base frame points, (N, 3)), or None."""
+        self.has_reach = points is not None and len(points) > 2 and bool(np.all(np.isfinite(points)))
+        edge = outline_points(np.asarray(points)) if self.has_reach else np.zeros((0, 3))
+        self.has_reach = self.has_reach and len(edge) > 0
+        show = self.has_reach and self.scene.show_reach
+        with self.server.atomic():
+            if len(edge):
+                self.outline.points = edge.astype(np.float32)
+                self.outline.colors = np.array(OUTLINE_COLOUR, dtype=np.uint8)
+                self.outline_label.position = edge[int(np.argmax(edge[:, 1]))] + np.array([0.0, 0.0, 0.05])
+            self.outline.visible = self.outline_label.visible = show
+
     def set_path(self, curve: np.ndarray | None) -> None:
         """Arrowheads along the current path's end-effector curve (base frame, in path order = increasing ū)."""
         pts = None if curve is None else np.asarray(curve, dtype=float)
