@@ -11,7 +11,6 @@ import numpy as np
 import trimesh
 import viser
 
-from rns_viz.live.readouts import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.robot import RobotMeshes
@@ -50,13 +49,8 @@ class Ghost:
         assert root is not None
         self.root = root
         self.base_drawing = _ghost_base(server, model, style.base)
-        reach = arm_reach(model)  # m: the label sits back along the base, clear of the base's own label
-        self.label = server.scene.add_label(
-            f"{self.BASE}/label",
-            "shadow run",
-            position=np.add(style.base_label, (0.0, -0.6 * reach, 0.0)),
-            anchor="top-center",
-        )
+        # On the ghost's last joint: the label moves with the ghost, clear of the base's own label.
+        self.label = server.scene.add_label(f"{self.robot.node_names[-1]}/ghost_label", "shadow run", anchor="top-left")
         self.q: np.ndarray | None = None  # the shadow's q as drawn (before exaggeration)
         self.exaggeration = float("nan")
         self.root.visible = False

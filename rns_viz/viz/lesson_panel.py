@@ -65,6 +65,7 @@ class LessonPanel:
         self._wire(self.stop, lambda c: session.stop_lesson(c))
         self._wire(self.start, self._start_chosen)
         self._shown = NO_LESSON
+        self._lesson: tuple[str, int] | None = None
 
     def _wire(self, button: viser.GuiButtonHandle, act: Callable[[int | None], None]) -> None:
         @button.on_click
@@ -106,6 +107,12 @@ class LessonPanel:
             self._shown = text
             self.text.content = text
         status = snap.lesson
+        shown = None if status is None else (status.model, status.number)
+        if shown != self._lesson:  # the chooser follows the lesson started (by any button or the CLI)
+            self._lesson = shown
+            name = next((k for k, v in CHOICES.items() if v == shown), None)
+            if name is not None and self.chooser.value != name:
+                self.chooser.value = name
         _set_disabled(self.previous, status is None or status.number <= 1)
         _set_disabled(self.next, status is not None and status.number >= status.count)
         _set_disabled(self.stop, status is None)
