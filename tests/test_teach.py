@@ -211,3 +211,28 @@ def test_reachable_region_outline_is_its_edge() -> None:
         wait_until(lambda: not teach.outline.visible and not app.scene.reachable.visible, 5.0, "the region to hide")
     finally:
         app.stop()
+
+
+def test_scene_recording_is_a_viser_file_of_the_moving_scene(trep_app: RnsApp) -> None:
+    import msgspec
+    import zstandard
+
+    app, s = trep_app, trep_app.session
+    assert app.recorder.record(1.0, None)
+    assert not app.recorder.record(1.0, None)  # one at a time
+    s.kick(0.8)
+    for _ in range(10):  # the scene moves while it records
+        s.advance(0.05)
+        time.sleep(0.1)
+    wait_until(lambda: app.recorder.last is not None, 30.0, "the recording")
+    data = app.recorder.last
+    assert data is not None
+    size = int.from_bytes(data[:8], "little")
+    inner = zstandard.ZstdDecompressor().decompress(data[8:], max_output_size=size)
+    n = int.from_bytes(inner[:8], "little")
+    payload = msgspec.msgpack.decode(inner[8 : 8 + n])
+    assert payload["durationSeconds"] == pytest.approx(1.0, abs=0.1)
+    names = {m.get("name") for _, m in payload["messages"]}
+    assert {"/ghost/base", "/base", "/base/reaction"} <= names  # the scene, the ghost and the arrows
+    moved = {m.get("name") for t, m in payload["messages"] if t > 0.0}
+    assert "/base" in moved and "/ghost/base" in moved  # both bases move during the recording
