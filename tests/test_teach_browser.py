@@ -1,22 +1,32 @@
 """Issue 11 in a real headless Chromium: a student walks lesson 1 (kick the base, watch it swing) with
 the ghost of the shadow run shown. Screenshots: artifacts/lesson1_start.png, lesson1_done.png and
 ghost_trep.png (the base deflection drawn x50: the arm swings, the ghost with suppression has settled),
-and picture_trep.png, saved by the app's Save picture button.
+picture_trep.png, saved by the app's Save picture button, and playback_trep.png: an exported recording
+playing in viser's own client from a static file server.
 """
 
 from __future__ import annotations
 
+import http.server
+import threading
+import time
 from collections.abc import Iterator
+from functools import partial
+from pathlib import Path
 
 import numpy as np
 import pytest
+from playwright.sync_api import sync_playwright
 
 from rns_viz.viz.app import RnsApp, start_app
 from rns_viz.viz.ghost import Ghost
+from rns_viz.viz.recording import PLAYER_URL, write_player_folder
 from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.teach_scene import TeachScene
 from tests.browser import (
     ARTIFACTS,
+    CHROMIUM,
+    CHROMIUM_FLAGS,
     browser_page,
     dismiss_notifications,
     local_position,
@@ -79,3 +89,37 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         download.value.save_as(path)
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
         assert app.pictures.saved == 1
+
+
+def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
+    """Record 1.5 s of a kicked TREP, export the player folder, serve it statically, open it in Chromium."""
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    try:
+        assert app.session.wait_background()
+        assert app.recorder.record(1.5, None)
+        app.session.kick(0.8)
+        for _ in range(15):
+            app.session.advance(0.05)
+            time.sleep(0.1)
+        wait_until(lambda: app.recorder.last is not None, 30.0, "the recording")
+        data = app.recorder.last
+    finally:
+        app.stop()
+    assert data is not None
+    write_player_folder(data, tmp_path)
+    handler = partial(http.server.SimpleHTTPRequestHandler, directory=str(tmp_path))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+            try:
+                page = browser.new_page(viewport={"width": 1280, "height": 800})
+                page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}", timeout=60_000)
+                wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, FsmsScene.ROBOT}, timeout=60.0)
+                wait_for_frames(page, 20)
+                assert screenshot(page, "playback_trep").stat().st_size > 10_000
+            finally:
+                browser.close()
+    finally:
+        httpd.shutdown()

@@ -1,7 +1,8 @@
 """Record the scene for viser's own player: a button records the next N seconds of the scene (the
 arm, the ghost, every overlay, as the browsers see them) with viser's scene serializer and hands the
-``.viser`` file to the clicking browser. The file plays in viser's built client from any static file
-server (``?playbackPath=...``), with no Python running: a demo prepared once, played in class.
+clicking browser a zip of a folder: viser's built client and the ``.viser`` file. Served by any static
+file server it plays (``index.html?playbackPath=rns_scene.viser``) with no Python running: a demo
+prepared once, played in class.
 
 Timing: a small thread inserts the wall-clock time between frames (30 Hz) while recording, so the
 file plays at the speed it was seen.
@@ -9,14 +10,19 @@ file plays at the speed it was seen.
 
 from __future__ import annotations
 
+import io
 import threading
 import time
 import traceback
+import zipfile
+from pathlib import Path
 
 import viser
 
 from rns_viz.viz.connections import Connections
 
+RECORDING_NAME = "rns_scene.viser"
+PLAYER_URL = f"index.html?playbackPath={RECORDING_NAME}"  # open this from a static server of the folder
 TICK_S = 1.0 / 30.0  # s between inserted sleeps (the player's time resolution)
 MAX_SECONDS = 60.0
 
@@ -40,8 +46,8 @@ class SceneRecorder:
             self.button = server.gui.add_button(
                 "Record the scene (.viser)",
                 icon=viser.Icon.PLAYER_RECORD,
-                hint="Records the scene as you see it and downloads a .viser file that viser's own player "
-                "plays from any static web server, without Python.",
+                hint="Records the scene as you see it and downloads a zip: a folder with viser's player and the "
+                f"recording; serve it with any static web server and open {PLAYER_URL}. No Python needed.",
             )
         self.button.on_click(self._on_click)
 
@@ -72,9 +78,32 @@ class SceneRecorder:
             data = serializer.serialize()
             self.last = data
             if client is not None:
-                client.send_file_download("rns_scene.viser", data, save_immediately=True)
+                client.send_file_download("rns_scene_player.zip", player_zip(data), save_immediately=True)
         except Exception as exc:  # a recording must never take the server down
             traceback.print_exc()
             self.connections.notify(client, "Recording failed", f"{type(exc).__name__}: {exc}", "error")
         finally:
             self._busy.release()
+
+
+def player_files(data: bytes) -> dict[str, bytes]:
+    """The files of a playable folder: viser's built client (one HTML file) and the recording."""
+    client = Path(viser.__file__).parent / "client" / "build" / "index.html"
+    return {"index.html": client.read_bytes(), RECORDING_NAME: data}
+
+
+def write_player_folder(data: bytes, folder: Path) -> Path:
+    """Write the playable folder; returns the page to open (relative: :data:`PLAYER_URL`)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, content in player_files(data).items():
+        (folder / name).write_bytes(content)
+    return folder / "index.html"
+
+
+def player_zip(data: bytes) -> bytes:
+    """The playable folder as a zip (what the button downloads)."""
+    with io.BytesIO() as buf:
+        with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+            for name, content in player_files(data).items():
+                z.writestr(f"rns_scene_player/{name}", content)
+        return buf.getvalue()
