@@ -236,3 +236,23 @@ def test_scene_recording_is_a_viser_file_of_the_moving_scene(trep_app: RnsApp) -
     assert {"/ghost/base", "/base", "/base/reaction"} <= names  # the scene, the ghost and the arrows
     moved = {m.get("name") for t, m in payload["messages"] if t > 0.0}
     assert "/base" in moved and "/ghost/base" in moved  # both bases move during the recording
+
+
+def test_hostile_values_for_the_new_controls_are_set_back_and_the_server_lives(trep_app: RnsApp) -> None:
+    from tests.browser import wait_for_clients
+    from tests.protocol_client import ProtocolClient, gui_uuid
+
+    app = trep_app
+    with ProtocolClient(app.port, decode=True) as ws:
+        wait_for_clients(app, 1, "the websocket client to connect")
+        box = app.view.boxes["ghost"]
+        ws.set_value(gui_uuid(box), "not a bool")
+        ws.set_value(gui_uuid(app.lessons.chooser), "no such lesson")
+        ws.click(gui_uuid(app.lessons.start))
+        ws.set_value(gui_uuid(app.recorder.seconds), 1e9)
+        time.sleep(1.0)
+        wait_until(lambda: box.value is True, 5.0, "the ghost box to be set back")
+        assert app.session.snapshot().lesson is None  # nothing started from a name that is no lesson
+        assert app.render_thread.is_alive()
+        app.session.advance(0.05)
+        assert np.all(np.isfinite(app.session.snapshot().q))
