@@ -132,6 +132,8 @@ def test_lesson_panel_starts_steps_and_shows_progress_through_the_protocol() -> 
         assert s.wait_background()
         wait_until(lambda: "Lesson 1 of 6" in app.lessons.text.content, 5.0, "lesson 1 in the panel")
         assert "✓" not in app.lessons.text.content and "Eq. (1)" in app.lessons.text.content
+        # Lesson 1 draws only what it explains: no ghost yet (suppression is lesson 4's subject).
+        assert not app.view.on("ghost") and not app.view.on("null_vector") and app.view.on("reaction")
         with ProtocolClient(app.port, decode=True) as ws:
             wait_for_clients(app, 1, "the websocket client to connect")
             s.kick(0.8)
@@ -143,6 +145,7 @@ def test_lesson_panel_starts_steps_and_shows_progress_through_the_protocol() -> 
             lesson = s.snapshot().lesson
             assert lesson is not None and lesson.number == 2 and not lesson.done
             wait_until(lambda: "Lesson 2 of 6" in app.lessons.text.content, 5.0, "lesson 2 in the panel")
+            assert app.view.on("coupling") and not app.view.on("ghost")  # lesson 2 is about L
             ws.set_value(gui_uuid(app.lessons.chooser), "3R 2. The reactionless-reachable set")
             wait_until(lambda: app.lessons.chooser.value.startswith("3R 2"), 5.0, "the chooser's new value")
             ws.click(gui_uuid(app.lessons.start))

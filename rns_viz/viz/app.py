@@ -44,7 +44,7 @@ class RnsApp:
         self.gui: GuiElements = make_gui(server, session.snapshot().settings.model)
         self.controls = Controls(self.gui, session, self.connections)
         self.view = make_view_toggles(server, self.connections)
-        self.lessons = LessonPanel(server, session, self.connections, order=self.gui.status.order + 0.5)
+        self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
         self.renderer = Renderer(server, session, self.gui, self.controls, self.connections, self.view)
         self.path_words = PathWords(server, self.gui.path_folder, order=self.gui.sigma.order + 0.01)
         self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]

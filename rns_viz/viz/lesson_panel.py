@@ -16,12 +16,27 @@ from rns_viz.live.lessons import LESSONS
 from rns_viz.live.records import LessonStatus, Snapshot
 from rns_viz.live.session import Session
 from rns_viz.viz.connections import Connections
+from rns_viz.viz.view_toggles import ViewToggles
 
 MODEL_SHORT = {"trep": "TREP", "planar3r": "3R"}
 CHOICES: dict[str, tuple[str, int]] = {
     f"{MODEL_SHORT[model]} {i + 1}. {lesson.title}": (model, i + 1)
     for model, lessons in LESSONS.items()
     for i, lesson in enumerate(lessons)
+}
+# What each lesson draws (the rest can be ticked by hand): only what the lesson has explained so far,
+# so lesson 1 shows no ghost (its suppression is lesson 4's subject) and no n (lesson 3's).
+BASICS = ("reaction", "trail")
+LESSON_VIEWS: dict[tuple[str, int], tuple[str, ...]] = {
+    ("trep", 1): BASICS,
+    ("trep", 2): (*BASICS, "coupling"),
+    ("trep", 3): (*BASICS, "coupling", "null_vector", "path_arrows"),
+    ("trep", 4): (*BASICS, "coupling", "ghost"),
+    ("trep", 5): (*BASICS, "coupling", "null_vector", "path_arrows"),
+    ("trep", 6): (*BASICS, "coupling", "null_vector", "path_arrows", "ghost"),
+    ("planar3r", 1): (*BASICS, "coupling", "reach"),
+    ("planar3r", 2): (*BASICS, "reach"),
+    ("planar3r", 3): (*BASICS, "coupling", "reach", "ghost"),
 }
 NO_LESSON = (
     "No lesson running. Pick one below and press **Start**, or press **Next** for lesson 1. Each lesson loads "
@@ -45,9 +60,14 @@ class LessonPanel:
     """Widgets of the Lessons folder and their callbacks (operator only)."""
 
     def __init__(
-        self, server: viser.ViserServer, session: Session, connections: Connections, order: float | None = None
+        self,
+        server: viser.ViserServer,
+        session: Session,
+        connections: Connections,
+        order: float | None = None,
+        view: ViewToggles | None = None,
     ) -> None:
-        self.session, self.connections = session, connections
+        self.session, self.connections, self.view = session, connections, view
         gui = server.gui
         with gui.add_folder("Lessons", order=order):
             self.text = gui.add_markdown(NO_LESSON)
@@ -113,6 +133,8 @@ class LessonPanel:
             name = next((k for k, v in CHOICES.items() if v == shown), None)
             if name is not None and self.chooser.value != name:
                 self.chooser.value = name
+            if shown is not None and self.view is not None and shown in LESSON_VIEWS:
+                self.view.show_only(LESSON_VIEWS[shown])
         _set_disabled(self.previous, status is None or status.number <= 1)
         _set_disabled(self.next, status is not None and status.number >= status.count)
         _set_disabled(self.stop, status is None)

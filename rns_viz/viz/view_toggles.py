@@ -6,7 +6,8 @@ no command to the session. Only the operator may change them (a watcher's change
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterable
+from dataclasses import dataclass, field
 
 import viser
 
@@ -64,10 +65,19 @@ class ViewToggles:
     """The checkboxes, by field name; ``on(name)`` is what the render thread reads."""
 
     boxes: dict[str, viser.GuiCheckboxHandle]
+    good: dict[str, bool] = field(default_factory=dict)  # the values in force (a hostile value is set back)
 
     def on(self, name: str) -> bool:
         box = self.boxes.get(name)
         return True if box is None else box.value is True
+
+    def show_only(self, names: Iterable[str]) -> None:
+        """Tick exactly ``names`` (a lesson's view), as the server: no refusal, no callback work."""
+        wanted = set(names)
+        for name, box in self.boxes.items():
+            self.good[name] = name in wanted
+            if box.value != self.good[name]:
+                box.value = self.good[name]
 
 
 def make_view_toggles(server: viser.ViserServer, connections: Connections) -> ViewToggles:
@@ -90,4 +100,4 @@ def make_view_toggles(server: viser.ViserServer, connections: Connections) -> Vi
 
     for name, box in boxes.items():
         wire(name, box)
-    return ViewToggles(boxes)
+    return ViewToggles(boxes, good)
