@@ -53,14 +53,15 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, TeachScene.COUPLING})
         dismiss_notifications(page)
         page.get_by_text("Lesson 1 of 6", exact=False).wait_for(timeout=20_000)
-        # Lesson 1 hides the ghost (not explained yet); the student ticks it under "Show in the scene".
-        wait_until(lambda: not app.view.on("ghost"), 10.0, "lesson 1's view")
-        page.get_by_text("Show in the scene", exact=True).click()
-        page.get_by_role("checkbox", name="Ghost: the shadow run").click()
-        wait_until(lambda: app.view.on("ghost"), 10.0, "the ghost to be ticked")
+        wait_until(lambda: not app.view.on("ghost"), 10.0, "lesson 1's view")  # no ghost: not explained yet
         page.mouse.move(5, 5)
         wait_for_frames(page, 20)
         assert screenshot(page, "lesson1_start").stat().st_size > 10_000
+        # The student ticks the ghost under "Show in the scene", then scrolls back to the lesson.
+        page.get_by_text("Show in the scene", exact=True).click()
+        page.get_by_role("checkbox", name="Ghost: the shadow run").click()
+        wait_until(lambda: app.view.on("ghost"), 10.0, "the ghost to be ticked")
+        page.get_by_text("Lesson 1 of 6", exact=False).scroll_into_view_if_needed()
 
         # The student's task: kick the base and watch it swing (suppression is off in lesson 1).
         page.get_by_role("button", name="Kick the base").click()
