@@ -217,7 +217,13 @@ def cmd_serve(args: argparse.Namespace) -> None:
         who = "" if gated else " and anyone may take control (no --password)"
         print(f"rns-viz: warning: binding {args.host}: other machines can reach this app{who}", file=sys.stderr)
     password = args.password or os.environ.get("RNS_VIZ_PASSWORD") or None
-    serve(model=args.model, host=args.host, port=args.port, password=password)
+    if args.lesson is not None:
+        from rns_viz.live.lessons import LESSONS
+
+        count = len(LESSONS[args.model])
+        if args.lesson > count:
+            raise CliError(f"{args.model} has lessons 1 to {count}, not {args.lesson}")
+    serve(model=args.model, host=args.host, port=args.port, password=password, lesson=args.lesson)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -226,6 +232,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Reaction null-space control of a flexible-structure-mounted manipulator "
         "(Nenchev et al. 1999). Without a command, starts the browser app.",
     )
+    lesson_help = "start the app at lesson N of the model (TREP: 1-6, planar3r: 1-3)"
+    parser.add_argument("--lesson", dest="top_lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
     sub = parser.add_subparsers(dest="command")
     info = sub.add_parser("info", help="print a model's dimensions and base parameters as JSON")
     info.add_argument("--model", type=_model_arg, default="trep", help=MODEL_HELP)
@@ -266,6 +274,7 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
+    serve.add_argument("--lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
     serve.set_defaults(func=cmd_serve)
     return parser
 
@@ -273,8 +282,11 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    top_lesson = args.top_lesson
     if args.command is None:
         args = parser.parse_args(["serve"])
+    if top_lesson is not None and getattr(args, "lesson", 0) is None:
+        args.lesson = top_lesson  # rns-viz --lesson N [serve ...]
     try:
         args.func(args)
     except (CliError, ModelFileError) as exc:

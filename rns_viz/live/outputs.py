@@ -13,6 +13,7 @@ import numpy as np
 
 from rns_viz.control import ControlOutput
 from rns_viz.live.plots import PlotBuffers
+from rns_viz.live.reaction import ReactionProbe
 from rns_viz.live.readouts import compute_readouts
 from rns_viz.live.records import Readouts
 from rns_viz.live.runs import RunPair
@@ -20,7 +21,7 @@ from rns_viz.model import FsmsModel
 
 PLOT_EVERY = 20  # steps between plot samples (50 Hz: a 10 s window is 500 samples)
 READOUT_EVERY = 50  # steps between readout updates (20 Hz)
-REACTION_TAU = 0.01  # s, low-pass of the reaction force shown by the arrow
+REACTION_EVERY = 4  # steps between evaluations of the arm's reaction (250 Hz: every published snapshot)
 
 
 def reference_point(model: FsmsModel, out: ControlOutput | None) -> np.ndarray | None:
@@ -38,14 +39,16 @@ class Outputs:
     def __init__(self, plot_capacity: int = 500) -> None:
         self.plots = PlotBuffers(plot_capacity)
         self.steps = 0  # steps booked since the session started (never reset: readers wait on it)
+        self._probe: ReactionProbe | None = None
         self.restart(None)
 
     def restart(self, model: FsmsModel | None, q: np.ndarray | None = None) -> None:
         """Forget history (reset, model switch, preset load)."""
         self.plots.clear()
         self.last: ControlOutput | None = None
-        self._last_L = 0.0
-        self.reaction = 0.0  # N: the arm's reaction on the base, -dL/dt, low-passed
+        self.reaction = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1), first selected row
+        self.reaction_t = math.nan  # s: the step it was evaluated at (its start time)
+        self._pre: tuple[float, np.ndarray] | None = None  # (t, x = (q, v)) the next evaluated step starts from
         self.ee_error = math.nan  # m
         self.readouts = Readouts()
         if model is not None and q is not None:
@@ -57,16 +60,27 @@ class Outputs:
         """Book one step of the operated run (``model`` is the loop's own instance for kinematics;
         ``suppress``: the operated run has suppression on, so the shadow has it off)."""
         self.steps += 1
-        dt = runs.sim.dt
-        L = float(out.coupling_momentum[0])
-        force = -(L - self._last_L) / dt if self.last is not None else 0.0
-        self._last_L = L
-        self.reaction += (force - self.reaction) * min(1.0, dt / REACTION_TAU)
         self.last = out
+        sim = runs.sim
+        if self.steps % REACTION_EVERY == 0 and self._pre is not None and self._pre[0] + sim.dt == sim.t:
+            self._evaluate_reaction(runs, out)
+        if (self.steps + 1) % REACTION_EVERY == 0:  # the next step is evaluated: keep its start state
+            self._pre = (sim.t, np.concatenate((sim.q, sim.v)))
         if self.steps % PLOT_EVERY == 0:
             self._sample_plots(model, runs, out, shadow_on, suppress)
         if self.steps % READOUT_EVERY == 0:
             self._update_readouts(model, runs.sim.q)
+
+    def _evaluate_reaction(self, runs: RunPair, out: ControlOutput) -> None:
+        """The reaction at the step just taken, from its start state, torque and base force."""
+        assert self._pre is not None
+        sim = runs.sim
+        if self._probe is None or self._probe.model is not sim.model:
+            self._probe = ReactionProbe(sim.model)
+        t, x = self._pre
+        nv = sim.model.nv
+        f = self._probe.force(x[:nv], x[nv:], out.tau, sim.last_force)
+        self.reaction, self.reaction_t = float(f[sim.model.selected[0]]), t
 
     def _sample_plots(
         self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool, suppress: bool
@@ -90,7 +104,7 @@ class Outputs:
 
     def _update_readouts(self, model: FsmsModel, q: np.ndarray) -> None:
         L = L_of(self.last) if self.last is not None else 0.0
-        self.readouts = compute_readouts(model, q, L, self.ee_error, self.reaction)
+        self.readouts = compute_readouts(model, q, L, self.ee_error, self.reaction, self.reaction_t)
 
 
 def L_of(out: ControlOutput) -> float:

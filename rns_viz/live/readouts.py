@@ -36,7 +36,9 @@ def _warning_levels(name: str) -> tuple[float, float]:
     return 0.1 * s_h, 0.1 * s_j
 
 
-def compute_readouts(model: FsmsModel, q: np.ndarray, L: float, ee_error: float, reaction: float) -> Readouts:
+def compute_readouts(
+    model: FsmsModel, q: np.ndarray, L: float, ee_error: float, reaction: float, reaction_t: float = float("nan")
+) -> Readouts:
     """Readouts at the configuration q = (x_b, theta); ``model`` is the loop's own instance."""
     H, s_h, s_j, rns_dim = _sigmas(model, q[model.m :])
     warn_h, warn_j = _warning_levels(model.name)
@@ -50,4 +52,5 @@ def compute_readouts(model: FsmsModel, q: np.ndarray, L: float, ee_error: float,
         L=L,
         ee_error=ee_error,
         reaction=reaction,
+        reaction_t=reaction_t,
     )

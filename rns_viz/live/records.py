@@ -60,7 +60,8 @@ class Readouts:
     rns_dim: int = 0
     L: float = 0.0  # kg m/s: coupling momentum S H_bm theta' (first selected row)
     ee_error: float = math.nan  # m: |x_ref - x_e|
-    reaction: float = 0.0  # N: the arm's reaction on the base, -dL/dt (low-passed)
+    reaction: float = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1)
+    reaction_t: float = math.nan  # s: start time of the step it was evaluated at
 
 
 @dataclass(frozen=True)

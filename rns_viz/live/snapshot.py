@@ -26,7 +26,7 @@ def make_snapshot(
     paused, diverged, rtf, behind = flags
     table = op.table if op is not None and op.on_path else None
     mode, target = (op.mode, op.target) if op is not None else (f"preset {settings.preset}", None)
-    readouts = replace(out.readouts, reaction=out.reaction)
+    readouts = replace(out.readouts, reaction=out.reaction, reaction_t=out.reaction_t)
     shadow_on = settings.shadow
     return Snapshot(
         epoch=epoch,

@@ -24,8 +24,13 @@ from rns_viz.model import FsmsModel
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gui import GuiElements, make_gui
 from rns_viz.viz.inputs import Controls
+from rns_viz.viz.lesson_panel import LessonPanel
+from rns_viz.viz.path_words import PathWords
+from rns_viz.viz.pictures import Pictures
+from rns_viz.viz.recording import SceneRecorder
 from rns_viz.viz.render import TARGET_HANDLE, Renderer
 from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.view_toggles import make_view_toggles
 
 IDLE_RESTART_S = 60.0  # s of simulated time: a session older than this restarts for its first visitor
 
@@ -40,7 +45,13 @@ class RnsApp:
         self.connections = Connections(server, password)
         self.gui: GuiElements = make_gui(server, session.snapshot().settings.model)
         self.controls = Controls(self.gui, session, self.connections)
-        self.renderer = Renderer(server, session, self.gui, self.controls, self.connections)
+        self.view = make_view_toggles(server, self.connections)
+        self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
+        self.renderer = Renderer(server, session, self.gui, self.controls, self.connections, self.view)
+        self.path_words = PathWords(server, self.gui.path_folder, order=self.gui.sigma.order + 0.01)
+        self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
+        self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
+        self.recorder = SceneRecorder(server, self.connections)
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
@@ -116,13 +127,17 @@ def start_app(
     password: str | None = None,
     realtime: bool = True,
     verbose: bool = True,
+    lesson: int | None = None,
 ) -> RnsApp:
-    """Start server, session and render thread; returns at once. ``port=0`` picks a free port."""
+    """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
+    ``lesson``: start at that lesson (1-based) of the model."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
         app = RnsApp(server, session, password).start()
+        if lesson is not None:
+            session.start_lesson(model, lesson)
     except Exception:
         session.stop()
         server.stop()
@@ -135,9 +150,15 @@ def start_app(
     return app
 
 
-def serve(model: str = "trep", host: str = "127.0.0.1", port: int = 8080, password: str | None = None) -> None:
+def serve(
+    model: str = "trep",
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    password: str | None = None,
+    lesson: int | None = None,
+) -> None:
     """Serve the live app until interrupted (Ctrl+C). Binds 127.0.0.1 unless told otherwise."""
-    app = start_app(model, host, port, password)
+    app = start_app(model, host, port, password, lesson=lesson)
     print(f"rns_viz live app: http://{host}:{app.port}  (Ctrl+C to stop)")
     try:
         while True:

@@ -35,20 +35,35 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
         0.0,
         50.0,
         0.1,
-        "Vibration suppression gain: base deflection (rate) feedback, Eqs. (15), (16), (30).",
+        "How hard the arm fights the base's swing (1/s): bigger damps faster. g_b of Eqs. (15), (16), (30).",
     ),
-    ("g_m", "g_m (1/s)", 0.0, 100.0, 0.1, "Joint gain: damping G_m in (15)/(16); position gain in (30)."),
-    ("G_p", "G_p (1/s²)", 0.0, 2000.0, 1.0, "End-effector position gain of Eq. (24) (planar 3R, laws 15/16)."),
-    ("G_d", "G_d (1/s)", 0.0, 500.0, 1.0, "End-effector velocity gain of Eq. (24) (planar 3R, laws 15/16)."),
+    (
+        "g_m",
+        "g_m (1/s)",
+        0.0,
+        100.0,
+        0.1,
+        "How firmly the joints are held (1/s). Two meanings: joint damping in laws (15)/(16), "
+        "the pull back to the path in law (30).",
+    ),
+    (
+        "G_p",
+        "G_p (1/s²)",
+        0.0,
+        2000.0,
+        1.0,
+        "How strongly the hand is pulled to the target (1/s²), Eq. (24) (planar 3R).",
+    ),
+    ("G_d", "G_d (1/s)", 0.0, 500.0, 1.0, "How much the hand's motion is damped (1/s), Eq. (24) (planar 3R)."),
     (
         "k_p",
         "k_p (1/s²)",
         0.0,
         2000.0,
         1.0,
-        "Joint-reference stiffness inside the reaction null space (TREP, laws 15/16).",
+        "How stiffly the joints follow the path's reference (1/s²), laws (15)/(16) (TREP).",
     ),
-    ("k_d", "k_d (1/s)", 0.0, 200.0, 0.5, "Joint-reference damping inside the reaction null space (TREP, laws 15/16)."),
+    ("k_d", "k_d (1/s)", 0.0, 200.0, 0.5, "How much the joints' following is damped (1/s), laws (15)/(16) (TREP)."),
 )
 
 
@@ -101,7 +116,12 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         "drag the **green handle**."
     )
     with gui.add_folder("Operate"):
-        kick = gui.add_button("Kick the base", icon=viser.Icon.HAND_FINGER, color="red")
+        kick = gui.add_button(
+            "Kick the base",
+            icon=viser.Icon.HAND_FINGER,
+            color="red",
+            hint="Push the base once with a short force pulse (size below, N); the shadow run gets the same push.",
+        )
         kick_peak = gui.add_slider(
             "Kick peak (N)",
             min=-KICK_RANGE[model],
@@ -111,9 +131,13 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R).",
         )
         suppression = gui.add_checkbox(
-            "Vibration suppression", True, hint="The g_b term of the control law; the shadow run has it the other way."
+            "Vibration suppression",
+            True,
+            hint="On: the arm moves to damp the base's swing (the g_b term). The ghost has it the other way.",
         )
-        pause = gui.add_button("Pause", icon=viser.Icon.PLAYER_PAUSE)
+        pause = gui.add_button(
+            "Pause", icon=viser.Icon.PLAYER_PAUSE, hint="Freeze the simulation; press again to go on."
+        )
         step = gui.add_button(
             "Step 1 ms", icon=viser.Icon.PLAYER_TRACK_NEXT, hint="Pauses, then advances one 1 ms step."
         )
@@ -145,24 +169,38 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             max=80.0,
             step=0.1,
             initial_value=0.0,
-            hint="The integral of u-bar in Eq. (30): the reference's position along the reactionless path.",
+            hint="Where the arm is along its reactionless path; the paper's ∫ū dt of Eq. (30), in 1/(kg·m). "
+            "The line below says it in joint angles.",
         )
-        play_slow = gui.add_button(f"Play path slowly ({FIG11_SLOW_S:g} s)", icon=viser.Icon.PLAYER_PLAY)
-        play_fast = gui.add_button(f"Play path fast ({FIG11_FAST_S:g} s)", icon=viser.Icon.PLAYER_PLAY)
+        play_slow = gui.add_button(
+            f"Play path slowly ({FIG11_SLOW_S:g} s)",
+            icon=viser.Icon.PLAYER_PLAY,
+            hint="Move the arm along the whole reactionless path in this many seconds (Fig. 11 a).",
+        )
+        play_fast = gui.add_button(
+            f"Play path fast ({FIG11_FAST_S:g} s)",
+            icon=viser.Icon.PLAYER_PLAY,
+            hint="The same path, fast: the base still stays still (Fig. 11 b).",
+        )
         point_to_point = gui.add_button(
             "Same end points, joint space",
             icon=viser.Icon.ARROWS_RIGHT_LEFT,
             hint="Fig. 11(b): a point-to-point joint motion ('link 2 only' from the start pose) between the end "
             "points of 'Play path fast', at the same speed. Watch the base.",
         )
-        cyclic = gui.add_button("Start cyclic motion", icon=viser.Icon.REPEAT)
+        cyclic = gui.add_button(
+            "Start cyclic motion",
+            icon=viser.Icon.REPEAT,
+            hint="Go round the path again and again at the ū speed below.",
+        )
         ubar_speed = gui.add_slider(
             "ū speed (1/(kg·m·s))",
             min=1.0,
             max=100.0,
             step=1.0,
             initial_value=30.0,
-            hint="u-bar of cyclic motion (Fig. 12: 30), and the top speed of scrubbing and dragging.",
+            hint="How fast the arm moves along the path, the paper's ū in 1/(kg·m·s) (Fig. 12 uses 30); "
+            "the line above turns it into joint speeds.",
         )
     with gui.add_folder("Target (planar 3R)") as target_folder:
         gui.add_markdown(
@@ -179,13 +217,24 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             hint="Speed limit of the smoothed target.",
         )
     with gui.add_folder("Control law and gains", expand_by_default=False):
-        law = gui.add_dropdown("Law", tuple(LAW_LABELS[k] for k in LAW_KINDS), initial_value=LAW_LABELS["velocity"])
+        law = gui.add_dropdown(
+            "Law",
+            tuple(LAW_LABELS[k] for k in LAW_KINDS),
+            initial_value=LAW_LABELS["velocity"],
+            hint="Which of the paper's control laws drives the arm: joint accelerations (15), torques (16) "
+            "or velocities (30).",
+        )
         gains = {
             name: gui.add_slider(label, min=lo, max=hi, step=step, initial_value=lo, hint=hint)
             for name, label, lo, hi, step, hint in GAIN_SLIDERS
         }
     with gui.add_folder("Model and view", expand_by_default=False):
-        model_dd = gui.add_dropdown("Model", tuple(MODEL_LABELS.values()), initial_value=MODEL_LABELS[model])
+        model_dd = gui.add_dropdown(
+            "Model",
+            tuple(MODEL_LABELS.values()),
+            initial_value=MODEL_LABELS[model],
+            hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring.",
+        )
         exaggeration = gui.add_slider(
             "Deflection drawn ×",
             min=1.0,
@@ -201,9 +250,16 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             hint="Simulated seconds per wall-clock second.",
         )
         shadow = gui.add_checkbox(
-            "Shadow run", True, hint="A second simulation with the same inputs and suppression the other way."
+            "Shadow run",
+            True,
+            hint="A second simulation with the same inputs and kicks and suppression the other way: "
+            "the blue ghost and the second plot lines.",
         )
-    download = gui.add_button("Download log (CSV)", icon=viser.Icon.DOWNLOAD)
+    download = gui.add_button(
+        "Download log (CSV)",
+        icon=viser.Icon.DOWNLOAD,
+        hint="The last 20 s of the simulation, one row per 1 ms step, SI units (see README).",
+    )
     return GuiElements(
         status=status,
         kick=kick,

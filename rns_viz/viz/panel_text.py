@@ -60,14 +60,26 @@ def readouts_html(snap: Snapshot) -> str:
         (
             "σ<sub>min</sub>(H<sub>bm</sub>)",
             _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
-            "distance to singularity of the coupling",
+            "how much grip the arm has on the base; near 0 it can neither push nor damp it",
         ),
-        ("σ(J̄)", _value(r.sigma_jbar, r.warn_jbar, "m/rad"), "distance to singularity of J̄ = J P<sub>RNS</sub>"),
-        ("n", n, "null-space vector, Eq. (27)"),
-        ("L = H<sub>bm</sub>θ̇", si(r.L, "N·s", 1e-9, True), "coupling momentum, Eq. (8); 1 N·s = 1 kg·m/s"),
-        ("x<sub>b</sub>", si(float(snap.q[0]), "m", 1e-9, True), "base deflection"),
-        ("end-effector error", err, "|x<sub>ref</sub> − x<sub>e</sub>|"),
-        ("reaction on base", si(r.reaction, "N", 1e-6, True), "red arrow: −dL/dt, the arm's push on the base"),
+        (
+            "σ(J̄)",
+            _value(r.sigma_jbar, r.warn_jbar, "m/rad"),
+            "how freely the hand can move without pushing the base (J̄ = J P<sub>RNS</sub>)",
+        ),
+        ("n", n, "the joint direction that pushes the base not at all (orange arrow: the hand's way), Eq. (27)"),
+        (
+            "L = H<sub>bm</sub>θ̇",
+            si(r.L, "N·s", 1e-9, True),
+            "momentum the joints hand to the base (purple arrow), Eq. (8); 1 N·s = 1 kg·m/s",
+        ),
+        ("x<sub>b</sub>", si(float(snap.q[0]), "m", 1e-9, True), "how far the base is bent from rest"),
+        ("end-effector error", err, "how far the hand is from where the law sends it"),
+        (
+            "reaction on base",
+            si(r.reaction, "N", 1e-6, True),
+            "red arrow: −(H_bm θ'' + c_b), Eq. (1): the arm's push on the base",
+        ),
     ]
     body = "".join(
         f'<tr title="{hint}"><td style="padding-right:8px">{name}</td><td>{value}</td></tr>'

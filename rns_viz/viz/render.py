@@ -10,6 +10,7 @@ from __future__ import annotations
 import threading
 import time
 import traceback
+from collections.abc import Callable
 
 import numpy as np
 import viser
@@ -32,6 +33,8 @@ from rns_viz.viz.gui import (
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.panel_text import readouts_html, status_html
 from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.teach_scene import TeachScene
+from rns_viz.viz.view_toggles import ViewToggles
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
@@ -52,8 +55,11 @@ class Renderer:
         gui: GuiElements,
         controls: Controls,
         connections: Connections,
+        view: ViewToggles | None = None,
     ) -> None:
         self.server = server
+        self.view = view or ViewToggles({})
+        self.text_panels: list[Callable[[Snapshot], None]] = []  # more panels refreshed with the text (5 Hz)
         self.session = session
         self.gui = gui
         self.controls = controls
@@ -81,6 +87,8 @@ class Renderer:
         self.model = FsmsModel.from_name(snap.settings.model)  # drawing only (its own pinocchio data)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
         self._reach = arm_reach(self.model)
+        self.teach = TeachScene(self.server, self.model, self.scene)
+        self.teach.reaction_label = REACTION_LABEL
         st = self.scene.style
         self.handle = self.server.scene.add_transform_controls(
             TARGET_HANDLE,
@@ -138,6 +146,9 @@ class Renderer:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
         self._draw_state(snap)
+        exaggeration = float(self.controls.good(self.gui.exaggeration))
+        q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
+        self.teach.draw(snap, q_shadow, exaggeration, self.view)
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
             self._draw_overlays()
@@ -169,7 +180,8 @@ class Renderer:
             seen.q, seen.exaggeration = q, exaggeration
             with self.server.atomic():
                 self.scene.update(q, exaggeration)
-                self.scene.set_reaction_force(self._drawn_force(snap.readouts.reaction), REACTION_LABEL)
+                f = snap.readouts.reaction  # N, exactly the readout's (Eq. 1); the label shows 3 digits
+                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, REACTION_LABEL)
             self.scene_updates += 1
 
     def _draw_target(self, snap: Snapshot) -> None:
@@ -196,12 +208,6 @@ class Renderer:
         out[:m] = np.clip(np.round(q[:m] / quantum) * quantum, -10.0, 10.0)
         return out
 
-    def _drawn_force(self, f: float) -> float:
-        """The reaction force rounded to 4 % of the longest arrow (N): smaller changes are not drawn."""
-        st = self.scene.style
-        quantum = 0.04 * st.force_arrow_max / st.force_scale
-        return round(f / quantum) * quantum if np.isfinite(f) else 0.0
-
     def _draw_overlays(self) -> None:
         ov = self.session.overlays()
         curves = list(ov.family or [])
@@ -212,6 +218,8 @@ class Renderer:
         else:  # no family and no current path (yet): the last model's or preset's must not stay lit
             self.scene.paths.visible = False
         self.scene.set_reachable_set(ov.reach)
+        self.teach.set_reach(ov.reach)
+        self.teach.set_path(ov.current)
 
     # ---------------------------------------------------------------- the panel
     def _update_plots(self, snap: Snapshot) -> None:
@@ -231,6 +239,8 @@ class Renderer:
             g.status.content = status
         if g.readouts.content != readouts:
             g.readouts.content = readouts
+        for refresh in self.text_panels:
+            refresh(snap)
         pause_label = "Reset (diverged)" if snap.diverged else "Resume" if snap.paused else "Pause"
         if g.pause.label != pause_label:
             g.pause.label = pause_label

@@ -15,6 +15,7 @@ from functools import partial
 
 import numpy as np
 import pinocchio as pin
+import trimesh
 import viser
 import yourdfpy
 
@@ -50,7 +51,7 @@ class RobotMeshes:
         self.frames = [server.scene.add_frame(name, show_axes=False) for name in self.node_names[1:]]
         self._world_posed = model.m  # joints 1..m are posed in the world, the rest relative to parents
         self._last: list[tuple[tuple[float, ...], tuple[float, ...]] | None] = [None] * len(self.frames)
-        self.meshes: list[viser.MeshHandle] = []
+        self.meshes: list[viser.SceneNodeHandle] = []
         scene = urdf.scene
         for geom_name, mesh in scene.geometry.items():
             link = scene.graph.transforms.parents[geom_name]
@@ -58,7 +59,11 @@ class RobotMeshes:
             local = mesh.copy()
             local.apply_transform(frame.placement.homogeneous @ urdf.get_transform(geom_name, link))
             node = self.node_names[frame.parentJoint]
-            self.meshes.append(server.scene.add_mesh_trimesh(f"{node}/{link}_{geom_name}", local))
+            self.meshes.append(self._add_mesh(server, f"{node}/{link}_{geom_name}", local))
+
+    def _add_mesh(self, server: viser.ViserServer, name: str, mesh: trimesh.Trimesh) -> viser.SceneNodeHandle:
+        """One visual; a subclass may draw it otherwise (the ghost: one translucent colour)."""
+        return server.scene.add_mesh_trimesh(name, mesh)
 
     def pose(self, q: np.ndarray) -> None:
         """Forward kinematics at ``q`` (pinocchio order); send the joint poses that changed."""

@@ -107,6 +107,7 @@ class FsmsScene:
         )
         self.force_label = scene.add_label(self.FORCE_LABEL, "", anchor="top-center", visible=False)
         self._force = 0.0
+        self.show_force = self.show_trail = self.show_reach = True  # the view toggles (render thread)
         self._force_axis = model.base_axes()[0] if model.base_is_translational else np.array([1.0, 0.0, 0.0])
         self._force_origin = np.asarray(st.force_origin, dtype=float)
         self.trail = Trail(st.trail_capacity, st.trail_step or 0.25 * st.marker_radius, st.trail_jump)
@@ -145,12 +146,12 @@ class FsmsScene:
 
         The arrow's label reads "<label> = f N".
         """
-        if f == self._force:
+        if f == self._force and self.force.visible == self.show_force:
             return
         self._force = f
         st = self.style
         length = float(np.clip(f * st.force_scale, -st.force_arrow_max, st.force_arrow_max))
-        show = abs(length) > 0.5 * self.force.head_length
+        show = self.show_force and abs(length) > 0.5 * self.force.head_length
         with self.server.atomic():
             self.force.visible = show
             self.force_label.visible = show
@@ -193,7 +194,7 @@ class FsmsScene:
         with self.server.atomic():
             self.reachable.points = np.asarray(points, dtype=np.float32)
             self.reachable.colors = np.array(REACH_COLOUR, dtype=np.uint8)
-            self.reachable.visible = True
+            self.reachable.visible = self.show_reach
 
     def set_target(self, position: np.ndarray | None) -> None:
         """End-effector target marker at a base-frame position (m), or None to hide it."""
@@ -235,7 +236,7 @@ class FsmsScene:
         if len(pts) < 2:
             return
         self.trail_node.points = polyline_segments(pts)
-        self.trail_node.visible = True
+        self.trail_node.visible = self.show_trail
 
     def _add_labels(self) -> None:
         scene, st = self.server.scene, self.style

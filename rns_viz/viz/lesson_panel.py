@@ -1,0 +1,145 @@
+"""The *Lessons* folder: the lesson in progress (title, equation, explanation, task, progress, ✓ when
+done), Previous / Next / Stop, and a chooser over every lesson of both models.
+
+The lessons and their checks live in :mod:`rns_viz.live.lessons`; this panel only starts and stops
+them through the session and shows ``snapshot().lesson``. Refreshed by the render thread at 5 Hz.
+"""
+
+from __future__ import annotations
+
+import traceback
+from collections.abc import Callable
+
+import viser
+
+from rns_viz.live.lessons import LESSONS
+from rns_viz.live.records import LessonStatus, Snapshot
+from rns_viz.live.session import Session
+from rns_viz.viz.connections import Connections
+from rns_viz.viz.view_toggles import ViewToggles
+
+MODEL_SHORT = {"trep": "TREP", "planar3r": "3R"}
+CHOICES: dict[str, tuple[str, int]] = {
+    f"{MODEL_SHORT[model]} {i + 1}. {lesson.title}": (model, i + 1)
+    for model, lessons in LESSONS.items()
+    for i, lesson in enumerate(lessons)
+}
+# What each lesson draws (the rest can be ticked by hand): only what the lesson has explained so far,
+# so lesson 1 shows no ghost (its suppression is lesson 4's subject) and no n (lesson 3's).
+BASICS = ("reaction", "trail")
+LESSON_VIEWS: dict[tuple[str, int], tuple[str, ...]] = {
+    ("trep", 1): BASICS,
+    ("trep", 2): (*BASICS, "coupling"),
+    ("trep", 3): (*BASICS, "coupling", "null_vector", "path_arrows"),
+    ("trep", 4): (*BASICS, "coupling", "ghost"),
+    ("trep", 5): (*BASICS, "coupling", "null_vector", "path_arrows"),
+    ("trep", 6): (*BASICS, "coupling", "null_vector", "path_arrows", "ghost"),
+    ("planar3r", 1): (*BASICS, "coupling", "reach"),
+    ("planar3r", 2): (*BASICS, "reach"),
+    ("planar3r", 3): (*BASICS, "coupling", "reach", "ghost"),
+}
+NO_LESSON = (
+    "No lesson running. Pick one below and press **Start**, or press **Next** for lesson 1. Each lesson loads "
+    "a state, gives you a task and tells you when the simulation shows it done."
+)
+
+
+def lesson_markdown(status: LessonStatus | None) -> str:
+    """The panel text for a lesson status (or the invitation when none runs)."""
+    if status is None:
+        return NO_LESSON
+    mark = " ✓" if status.done else ""
+    progress = "**Done.** Press *Next* for the next lesson." if status.done else status.progress
+    return (
+        f"**Lesson {status.number} of {status.count}: {status.title}**{mark}\n\n"
+        f"*Paper: {status.equation}*\n\n{status.text}\n\n**Task:** {status.task}\n\n{progress}"
+    )
+
+
+class LessonPanel:
+    """Widgets of the Lessons folder and their callbacks (operator only)."""
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        session: Session,
+        connections: Connections,
+        order: float | None = None,
+        view: ViewToggles | None = None,
+    ) -> None:
+        self.session, self.connections, self.view = session, connections, view
+        gui = server.gui
+        with gui.add_folder("Lessons", order=order):
+            self.text = gui.add_markdown(NO_LESSON)
+            self.previous = gui.add_button("Previous", icon=viser.Icon.PLAYER_SKIP_BACK, hint="The lesson before.")
+            self.next = gui.add_button(
+                "Next", icon=viser.Icon.PLAYER_SKIP_FORWARD, hint="The next lesson (lesson 1 when none runs)."
+            )
+            self.stop = gui.add_button("Stop lesson", icon=viser.Icon.PLAYER_STOP, hint="Leave the lesson mode.")
+            self.chooser = gui.add_dropdown(
+                "Lesson", tuple(CHOICES), hint="Every lesson of both models; Start loads the chosen one."
+            )
+            self.start = gui.add_button("Start", icon=viser.Icon.PLAYER_PLAY, hint="Start the lesson chosen above.")
+        self._wire(self.previous, lambda c: self._step(-1, c))
+        self._wire(self.next, lambda c: self._step(+1, c))
+        self._wire(self.stop, lambda c: session.stop_lesson(c))
+        self._wire(self.start, self._start_chosen)
+        self._shown = NO_LESSON
+        self._lesson: tuple[str, int] | None = None
+
+    def _wire(self, button: viser.GuiButtonHandle, act: Callable[[int | None], None]) -> None:
+        @button.on_click
+        def _(event: viser.GuiEvent) -> None:
+            client = event.client
+            if not self.connections.allowed(client):
+                self.connections.refuse_watcher(client)
+                return
+            try:
+                act(None if client is None else client.client_id)
+            except ValueError as exc:
+                self.connections.notify(client, "Lesson not started", str(exc), "warning")
+            except Exception as exc:  # never let a click kill the server
+                traceback.print_exc()
+                self.connections.notify(client, "Lesson not started", f"{type(exc).__name__}: {exc}", "error")
+
+    def _step(self, direction: int, client: int | None) -> None:
+        snap = self.session.snapshot()
+        status = snap.lesson
+        if status is None:
+            self.session.start_lesson(snap.settings.model if snap.settings.model in LESSONS else "trep", 1, client)
+            return
+        number = status.number + direction
+        if 1 <= number <= status.count:
+            self.session.start_lesson(status.model, number, client)
+        else:
+            raise ValueError("that was the last lesson" if direction > 0 else "this is the first lesson")
+
+    def _start_chosen(self, client: int | None) -> None:
+        choice = CHOICES.get(self.chooser.value)
+        if choice is None:
+            raise ValueError(f"no lesson named {self.chooser.value!r}")
+        self.session.start_lesson(*choice, client=client)
+
+    def refresh(self, snap: Snapshot) -> None:
+        """Show the lesson in progress (render thread, at text rate)."""
+        text = lesson_markdown(snap.lesson)
+        if text != self._shown:
+            self._shown = text
+            self.text.content = text
+        status = snap.lesson
+        shown = None if status is None else (status.model, status.number)
+        if shown != self._lesson:  # the chooser follows the lesson started (by any button or the CLI)
+            self._lesson = shown
+            name = next((k for k, v in CHOICES.items() if v == shown), None)
+            if name is not None and self.chooser.value != name:
+                self.chooser.value = name
+            if shown is not None and self.view is not None and shown in LESSON_VIEWS:
+                self.view.show_only(LESSON_VIEWS[shown])
+        _set_disabled(self.previous, status is None or status.number <= 1)
+        _set_disabled(self.next, status is not None and status.number >= status.count)
+        _set_disabled(self.stop, status is None)
+
+
+def _set_disabled(button: viser.GuiButtonHandle, disabled: bool) -> None:
+    if button.disabled != disabled:  # send only changes
+        button.disabled = disabled

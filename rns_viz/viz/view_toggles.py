@@ -1,0 +1,103 @@
+"""The *Show in the scene* folder: one checkbox per thing the eye can't see, each with units in its hint.
+
+These are drawing choices of the server's one scene, read by the render thread each frame; they send
+no command to the session. Only the operator may change them (a watcher's change is set back).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import viser
+
+from rns_viz.viz.connections import Connections
+
+# (field, label, initial, hint): the hints are what a student reads on hovering.
+TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
+    (
+        "ghost",
+        "Ghost: the shadow run",
+        True,
+        "A second simulation with the same kicks and inputs but vibration suppression the other way, "
+        "drawn see-through (blue) over the arm.",
+    ),
+    (
+        "reaction",
+        "Reaction force on the base (N)",
+        True,
+        "Red arrow: the force the arm's motion puts on the base, −(H_bm θ'' + c_b) of Eq. (1), in newtons.",
+    ),
+    (
+        "coupling",
+        "Coupling momentum L (kg·m/s)",
+        True,
+        "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8). "
+        "Zero on a reactionless path.",
+    ),
+    (
+        "null_vector",
+        "Null-space direction n (m/s per unit ū)",
+        True,
+        "Orange arrow at the hand: where the hand goes when the joints turn along n, the one direction "
+        "that pushes the base not at all (Eq. 27); its length is J n, m/s per unit of ū.",
+    ),
+    ("trail", "End-effector trail", True, "Green line: where the hand has been, relative to the base (m)."),
+    (
+        "path_arrows",
+        "Path direction arrows",
+        True,
+        "Arrowheads on the red reactionless path pointing the way the arm moves when ū is positive.",
+    ),
+    (
+        "reach",
+        "Reactionless-reachable region (3R)",
+        True,
+        "Lilac dots: where the 3R's hand can go without ever pushing the base. The region ends at fold "
+        "curves, where the arm can no longer move the hand outward without moving its centre of mass "
+        "along the spring (J-bar loses rank).",
+    ),
+)
+
+
+@dataclass
+class ViewToggles:
+    """The checkboxes, by field name; ``on(name)`` is what the render thread reads."""
+
+    boxes: dict[str, viser.GuiCheckboxHandle]
+    good: dict[str, bool] = field(default_factory=dict)  # the values in force (a hostile value is set back)
+
+    def on(self, name: str) -> bool:
+        box = self.boxes.get(name)
+        return True if box is None else box.value is True
+
+    def show_only(self, names: Iterable[str]) -> None:
+        """Tick exactly ``names`` (a lesson's view), as the server: no refusal, no callback work."""
+        wanted = set(names)
+        for name, box in self.boxes.items():
+            self.good[name] = name in wanted
+            if box.value != self.good[name]:
+                box.value = self.good[name]
+
+
+def make_view_toggles(server: viser.ViserServer, connections: Connections) -> ViewToggles:
+    """The folder; a watcher's change (or a value that is not a bool) is set back and reported."""
+    with server.gui.add_folder("Show in the scene", expand_by_default=False):
+        boxes = {name: server.gui.add_checkbox(label, initial, hint=hint) for name, label, initial, hint in TOGGLES}
+    good = {name: box.value for name, box in boxes.items()}
+
+    def wire(name: str, box: viser.GuiCheckboxHandle) -> None:
+        @box.on_update
+        def _(event: viser.GuiEvent) -> None:
+            if box.value == good[name]:
+                return
+            if isinstance(box.value, bool) and connections.allowed(event.client):
+                good[name] = box.value
+                return
+            if not connections.allowed(event.client):
+                connections.refuse_watcher(event.client)
+            box.value = good[name]
+
+    for name, box in boxes.items():
+        wire(name, box)
+    return ViewToggles(boxes, good)

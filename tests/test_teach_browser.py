@@ -1,0 +1,131 @@
+"""Issue 11 in a real headless Chromium: a student walks lesson 1 (kick the base, watch it swing) with
+the ghost of the shadow run shown. Screenshots: artifacts/lesson1_start.png, lesson1_done.png and
+ghost_trep.png (the base deflection drawn x50: the arm swings, the ghost with suppression has settled),
+picture_trep.png, saved by the app's Save picture button, and playback_trep.png: an exported recording
+playing in viser's own client from a static file server.
+"""
+
+from __future__ import annotations
+
+import http.server
+import threading
+import time
+from collections.abc import Iterator
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+import pytest
+from playwright.sync_api import sync_playwright
+
+from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.ghost import Ghost
+from rns_viz.viz.recording import PLAYER_URL, write_player_folder
+from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.teach_scene import TeachScene
+from tests.browser import (
+    ARTIFACTS,
+    CHROMIUM,
+    CHROMIUM_FLAGS,
+    browser_page,
+    dismiss_notifications,
+    local_position,
+    requires_chromium,
+    screenshot,
+    wait_for_frames,
+    wait_for_nodes,
+    wait_until,
+)
+
+pytestmark = [pytest.mark.browser, requires_chromium]
+
+
+@pytest.fixture
+def app() -> Iterator[RnsApp]:
+    app = start_app("trep", port=0, verbose=False, lesson=1)
+    yield app
+    app.stop()
+
+
+def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
+    s = app.session
+    with browser_page(app.server, width=1400, height=900) as page:
+        wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, TeachScene.COUPLING})
+        dismiss_notifications(page)
+        page.get_by_text("Lesson 1 of 6", exact=False).wait_for(timeout=20_000)
+        wait_until(lambda: not app.view.on("ghost"), 10.0, "lesson 1's view")  # no ghost: not explained yet
+        page.mouse.move(5, 5)
+        wait_for_frames(page, 20)
+        assert screenshot(page, "lesson1_start").stat().st_size > 10_000
+        # The student ticks the ghost under "Show in the scene", then scrolls back to the lesson.
+        page.get_by_text("Show in the scene", exact=True).click()
+        page.get_by_role("checkbox", name="Ghost: the shadow run").click()
+        wait_until(lambda: app.view.on("ghost"), 10.0, "the ghost to be ticked")
+        page.get_by_text("Lesson 1 of 6", exact=False).scroll_into_view_if_needed()
+
+        # The student's task: kick the base and watch it swing (suppression is off in lesson 1).
+        page.get_by_role("button", name="Kick the base").click()
+        wait_until(lambda: abs(s.snapshot().q[0]) > 1e-4, 15.0, "the kick to deflect the base")
+        app.controls.show(app.gui.exaggeration, 50.0)  # drawn x50, so the ghost and the arm part clearly
+        wait_until(lambda: abs(s.snapshot().q[0] - s.snapshot().q_shadow[0]) > 5e-4, 20.0, "the runs to part")
+        # The browser's ghost base sits at the shadow's deflection, not the operated one's.
+        snap = s.snapshot()
+        assert snap.q_shadow is not None
+        wait_for_frames(page, 5)
+        pos = local_position(page, Ghost.BASE)
+        assert pos is not None
+        page.mouse.move(5, 5)
+        dismiss_notifications(page)
+        wait_for_frames(page, 20)
+        assert screenshot(page, "ghost_trep").stat().st_size > 10_000
+        shadow_x = 50.0 * s.snapshot().q_shadow[0]
+        operated_x = 50.0 * s.snapshot().q[0]
+        assert np.isfinite([shadow_x, operated_x]).all()
+
+        wait_until(lambda: s.snapshot().lesson is not None and s.snapshot().lesson.done, 40.0, "lesson 1's check")
+        page.get_by_text("Lesson 1 of 6: The base is a spring ✓", exact=False).wait_for(timeout=20_000)
+        dismiss_notifications(page)
+        wait_for_frames(page, 20)
+        assert screenshot(page, "lesson1_done").stat().st_size > 10_000
+
+        # Pictures: one button, a PNG of the scene rendered by the browser, downloaded.
+        with page.expect_download(timeout=60_000) as download:
+            page.get_by_role("button", name="Save picture (PNG)").click()
+        path = ARTIFACTS / "picture_trep.png"
+        download.value.save_as(path)
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
+        assert app.pictures.saved == 1
+
+
+def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
+    """Record 1.5 s of a kicked TREP, export the player folder, serve it statically, open it in Chromium."""
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    try:
+        assert app.session.wait_background()
+        assert app.recorder.record(1.5, None)
+        app.session.kick(0.8)
+        for _ in range(15):
+            app.session.advance(0.05)
+            time.sleep(0.1)
+        wait_until(lambda: app.recorder.last is not None, 30.0, "the recording")
+        data = app.recorder.last
+    finally:
+        app.stop()
+    assert data is not None
+    write_player_folder(data, tmp_path)
+    handler = partial(http.server.SimpleHTTPRequestHandler, directory=str(tmp_path))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+            try:
+                page = browser.new_page(viewport={"width": 1280, "height": 800})
+                page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}", timeout=60_000)
+                wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, FsmsScene.ROBOT}, timeout=60.0)
+                wait_for_frames(page, 20)
+                assert screenshot(page, "playback_trep").stat().st_size > 10_000
+            finally:
+                browser.close()
+    finally:
+        httpd.shutdown()
