@@ -108,6 +108,7 @@ class GainExplorerView:
         self._quantity = ""
         self._law = ""
         self.clicks_applied = 0
+        self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:
         """The model's scene was (re)built: add the map to it."""
@@ -131,6 +132,11 @@ class GainExplorerView:
         self._show_text(view)
         self._show_loci(view)
         self._widen_sliders(view)
+        clicked = self._clicked
+        if clicked is not None and clicked == (view.gains.g_b, view.gains.g_m):
+            self._clicked = None  # in force: the sliders show it (the session only re-syncs them after
+            self.controls.show(self.gui.gains["g_b"], clicked[0])  # input other than the operator's)
+            self.controls.show(self.gui.gains["g_m"], clicked[1])
 
     def _show_text(self, view: GainView) -> None:
         if view.law != self._law and view.g_m_meaning:
@@ -180,6 +186,7 @@ class GainExplorerView:
                 self.connections.notify(client, "Gains not applied", "The click was not on the gain map.", "warning")
                 return
             g_b, g_m = point
+            self._clicked = point
             self.session.set_gains(None if client is None else client.client_id, g_b=g_b, g_m=g_m)
             self.clicks_applied += 1
         except ValueError as exc:

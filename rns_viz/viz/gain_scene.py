@@ -143,7 +143,12 @@ class GainScene:
         self.gain_map: GainMap | None = None
         self.scale = (0.01, 1.0)  # 1/s, the map's colour scale (authority uses it too)
         self.authority = scene.add_point_cloud(
-            self.AUTHORITY, np.zeros((1, 3)), (0, 0, 0), point_size=0.6 * style.marker_radius, visible=False
+            self.AUTHORITY,
+            np.zeros((1, 3)),
+            (0, 0, 0),
+            point_size=0.6 * style.marker_radius,
+            precision="float32",
+            visible=False,
         )
         self.authority_lines = scene.add_line_segments(
             f"{self.AUTHORITY}_path",
@@ -234,6 +239,11 @@ class GainScene:
         o, d = np.asarray(origin, dtype=float), np.asarray(direction, dtype=float)
         if o.shape != (3,) or d.shape != (3,) or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d))):
             return None
+        with np.errstate(over="ignore", invalid="ignore"):
+            far, length = float(np.linalg.norm(o - self.centre)), float(np.linalg.norm(d))
+        if not (far < 1e4 * self.size and 1e-12 < length < np.inf):
+            return None  # no camera is that far away (and the arithmetic would be meaningless)
+        d = d / length
         normal = self.rotation[:, 2]
         denom = float(normal @ d)
         if abs(denom) < 1e-12:
