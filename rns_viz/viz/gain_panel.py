@@ -29,6 +29,7 @@ QUANTITIES: dict[str, Quantity] = {
     "base mode time to 10 % (s)": "time",
     "arm mode σ_a (1/s)": "arm",
 }
+RIGHT = 0.15  # the locus plots show Re λ up to this fraction of their left reach (unstable poles)
 BASE_COLOUR, ARM_COLOUR, NOW_COLOUR = "#e0503a", "#1f6fd1", "#111111"
 _SLIDER_MAX = {name: hi for name, _, _, hi, _, _ in GAIN_SLIDERS}
 _G_M_HINT = next(h for name, *_, h in GAIN_SLIDERS if name == "g_m")
@@ -154,15 +155,16 @@ class GainExplorerView:
             data = locus_data(locus, view.current, reach)
             if len(data[0]) < 2:
                 continue
-            top = float(np.nanmax(np.abs(np.concatenate([d[np.isfinite(d)] for d in data[1:]] or [np.ones(1)]))))
-            top = max(top, 0.1) * 1.1
+            shown = data[0] <= RIGHT * reach  # the y range fits the poles inside the x range
+            ims = np.concatenate([d[shown & np.isfinite(d)] for d in data[1:]])
+            top = 1.1 * max(float(np.max(np.abs(ims))) if len(ims) else 0.0, 0.1 * reach)
             plot.scales = {
-                "x": {"time": False, "auto": False, "range": (-reach, 0.1 * reach)},
+                "x": {"time": False, "auto": False, "range": (-reach, RIGHT * reach)},
                 "y": {"auto": False, "range": (-top, top)},
             }
             plot.data = data
             lo, hi = locus.values[0], locus.values[-1]
-            plot.title = f"Root locus: {locus.sweep} {lo:g}…{hi:g} 1/s at {other} = {locus.fixed:g} 1/s"
+            plot.title = f"Root locus: {locus.sweep} {lo:g}…{hi:g} 1/s at {other} = {locus.fixed:.4g} 1/s"
 
     def _widen_sliders(self, view: GainView) -> None:
         """A map click can apply gains beyond a slider's default range: widen it to the map's range."""
@@ -219,7 +221,7 @@ def _fmt_rate(rate: float) -> str:
 
 def predicted_html(view: GainView) -> str:
     """One line: predicted base decay at the gains in force, and after a kick the measured one."""
-    gains = f"g_b = {view.gains.g_b:g}, g_m = {view.gains.g_m:g} 1/s"
+    gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
     pred = f"<b>Base decay</b> at {gains}: predicted {_fmt_rate(view.predicted)}"
     m = view.measured
     if m is None:

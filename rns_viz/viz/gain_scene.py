@@ -114,8 +114,9 @@ class GainScene:
         up = np.cross(right, ahead)
         self.rotation = np.column_stack([right, up, -ahead])  # map x: g_b, y: g_m, z: towards the camera
         distance = float(np.linalg.norm(look - cam))
-        self.size = 0.42 * distance  # m, side of the map
-        self.centre = look - 0.62 * distance * right + 0.05 * distance * up
+        self.size = 0.36 * distance  # m, side of the map
+        # up and to the left of the robot, a little towards the camera: clear of the base drawing
+        self.centre = look + distance * (-0.5 * right + 0.27 * up - 0.2 * ahead)
         self.frame = scene.add_frame(
             self.FRAME,
             wxyz=vtf.SO3.from_matrix(self.rotation).wxyz,
