@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import math
+import time
 import traceback
 
 import numpy as np
@@ -31,6 +32,7 @@ QUANTITIES: dict[str, Quantity] = {
 }
 RIGHT = 0.15  # the locus plots show Re λ up to this fraction of their left reach (unstable poles)
 BASE_COLOUR, ARM_COLOUR, NOW_COLOUR = "#e0503a", "#1f6fd1", "#111111"
+CHECK_S = 0.1  # s: the view is checked at 10 Hz (its changes come in bursts: gains, poles, authority)
 _SLIDER_MAX = {name: hi for name, _, _, hi, _, _ in GAIN_SLIDERS}
 _G_M_HINT = next(h for name, *_, h in GAIN_SLIDERS if name == "g_m")
 
@@ -69,7 +71,7 @@ def locus_data(locus: Locus, now: Modes | None, reach: float) -> tuple[np.ndarra
     cols[0, : len(re)] = np.where(base, im, np.nan)
     cols[1, : len(re)] = np.where(base, np.nan, im)
     cols[2, len(re) :] = n_im
-    keep = np.isfinite(x) & (x >= -reach)
+    keep = np.isfinite(x) & (x >= -reach) & (x <= RIGHT * reach)
     order = np.argsort(x[keep], kind="stable")
     return (x[keep][order], *(c[keep][order] for c in cols))
 
@@ -109,6 +111,8 @@ class GainExplorerView:
         self._quantity = ""
         self._law = ""
         self.clicks_applied = 0
+        self._next_check = 0.0
+        self._drawn: dict[str, object] = {}
         self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:
@@ -116,22 +120,32 @@ class GainExplorerView:
         self.scene = GainScene(self.server, style, self._on_point)
         self.on_path = on_path
         self._version = -1
+        self._drawn = {}
 
     # -- per frame -------------------------------------------------------------------------------
     def frame(self) -> None:
+        now = time.perf_counter()
+        if now < self._next_check:
+            return
+        self._next_check = now + CHECK_S
         view = self.session.gain_view()
         quantity = QUANTITIES.get(self.controls.good(self.quantity), "base")
         if self.scene is None or (view.version == self._version and quantity == self._quantity):
             return
-        map_changed = view.map is not (self.scene.gain_map) or quantity != self._quantity
+        map_changed = view.map is not self.scene.gain_map or quantity != self._quantity
         self._version, self._quantity = view.version, quantity
         if map_changed:
             self.scene.show_map(view, quantity)
         else:
             self.scene.show_now(view)
-        self.scene.show_authority(view, self.on_path)
+        drawn = self._drawn  # send only what changed: the parts of a view are new objects when they change
+        if map_changed or not _same((view.authority, view.path_points), drawn.get("authority")):
+            drawn["authority"] = (view.authority, view.path_points)
+            self.scene.show_authority(view, self.on_path)
         self._show_text(view)
-        self._show_loci(view)
+        if not _same((view.locus_g_b, view.locus_g_m, view.current), drawn.get("loci")):
+            drawn["loci"] = (view.locus_g_b, view.locus_g_m, view.current)
+            self._show_loci(view)
         self._widen_sliders(view)
         clicked = self._clicked
         if clicked is not None and clicked == (view.gains.g_b, view.gains.g_m):
@@ -144,8 +158,12 @@ class GainExplorerView:
             self._law = view.law
             self.meaning.content = f"*{view.g_m_meaning}.*"
             self.gui.gains["g_m"].hint = f"{_G_M_HINT} Here: {view.g_m_meaning}."
-        self.predicted.content = predicted_html(view)
-        self.authority.content = authority_text(view, self.on_path)
+        for handle, text in (
+            (self.predicted, predicted_html(view)),
+            (self.authority, authority_text(view, self.on_path)),
+        ):
+            if handle.content != text:
+                handle.content = text
 
     def _show_loci(self, view: GainView) -> None:
         reach = _reach(view)
@@ -196,6 +214,13 @@ class GainExplorerView:
         except Exception as exc:  # a click must never take the server down
             traceback.print_exc()
             self.connections.notify(client, "Gains not applied", f"{type(exc).__name__}: {exc}", "error")
+
+
+def _same(parts: tuple[object, ...], drawn: object) -> bool:
+    """The very objects drawn last (identity: the view's parts are immutable, new when changed)."""
+    return (
+        isinstance(drawn, tuple) and len(drawn) == len(parts) and all(a is b for a, b in zip(parts, drawn, strict=True))
+    )
 
 
 def _reach(view: GainView) -> float:

@@ -217,7 +217,7 @@ class GainScene:
 
     def _draw_paper(self, gm: GainMap, paper: tuple[tuple[str, float, float], ...]) -> None:
         for handle in self._paper:
-            handle.remove()  # type: ignore[attr-defined]
+            handle.remove()  # type: ignore[attr-defined]  # (its label goes with it)
         self._paper = []
         scene = self.server.scene
         for k, (label, g_b, g_m) in enumerate(paper):
@@ -230,9 +230,7 @@ class GainScene:
                     name, radius=0.012 * self.size, color=PAPER_COLOUR, position=self._local(u, v, 0.01)
                 )
             )
-            self._paper.append(
-                scene.add_label(f"{name}/label", label, position=(-0.015 * self.size, 0.0, 0.0), anchor="center-right")
-            )
+            scene.add_label(f"{name}/label", label, position=(-0.015 * self.size, 0.0, 0.0), anchor="center-right")
 
     # -- clicks ----------------------------------------------------------------------------------
     def map_fractions(self, origin: np.ndarray, direction: np.ndarray) -> tuple[float, float] | None:
