@@ -207,3 +207,14 @@ def test_panel_states_the_views_and_the_loci_split_base_and_arm(app: RnsApp) -> 
     assert np.isfinite(base).sum() == view.locus_g_b.is_base.sum()
     assert np.isfinite(arm).sum() == (~view.locus_g_b.is_base).sum()
     assert np.isfinite(now).sum() == view.current.poles.size
+
+
+def test_after_a_kick_the_panel_sets_the_measured_decay_beside_the_prediction(app: RnsApp) -> None:
+    s, ex = app.session, explorer(app)
+    s.kick(0.8 if app.model_name == "trep" else 5.0)  # N, the kick slider's default
+    s.advance(9.0)  # the first fit comes 4 s after the kick, then every second
+    measured = s.gain_view().measured
+    assert measured is not None and np.isfinite(measured.rate)
+    wait_until(lambda: "measured" in ex.predicted.content, 10.0, "the panel to show the measured decay")
+    text = ex.predicted.content
+    assert f"{measured.rate:.3g} 1/s" in text and f"{s.gain_view().predicted:.3g} 1/s" in text

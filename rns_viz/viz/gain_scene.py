@@ -141,6 +141,7 @@ class GainScene:
         )
         self._ticks: list[object] = []
         self._paper: list[object] = []
+        self._paper_key: tuple[tuple[str, float, float], ...] | None = None
         self.gain_map: GainMap | None = None
         self.scale = (0.01, 1.0)  # 1/s, the map's colour scale (authority uses it too)
         self.authority = scene.add_point_cloud(
@@ -176,7 +177,9 @@ class GainScene:
             self.image.image = image
             if new_axes:
                 self._draw_ticks(gm)
-            self._draw_paper(gm, view.paper)
+            if new_axes or view.paper != self._paper_key:
+                self._paper_key = view.paper
+                self._draw_paper(gm, view.paper)
             self.show_now(view)
             self.title.text = _title(view, quantity)
             self.legend.text = _legend(quantity, self.scale)
