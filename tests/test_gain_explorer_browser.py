@@ -10,6 +10,7 @@ import pytest
 from playwright.sync_api import Page
 
 from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.gain_panel import QUANTITIES
 from rns_viz.viz.gain_scene import GainScene, axis_fraction
 from tests.browser import (
     browser_page,
@@ -83,4 +84,10 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
         page.get_by_text("Root locus: g_m", exact=False).first.scroll_into_view_if_needed()
         wait_for_frames(page, 10)
         assert screenshot(page, f"gain_loci_{app.model_name}").stat().st_size > 10_000
+        # The arm mode's map: the second subsystem of Sec. VIII.
+        legend = ex.scene.legend
+        app.controls.show(ex.quantity, next(k for k, q in QUANTITIES.items() if q == "arm"))
+        wait_until(lambda: legend.text.startswith("σ_a"), 10.0, "the arm mode's map")
+        wait_for_frames(page, 20)
+        assert screenshot(page, f"gain_map_arm_{app.model_name}").stat().st_size > 10_000
         assert np.isfinite(app.session.gain_view().predicted)

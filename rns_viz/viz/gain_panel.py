@@ -31,6 +31,7 @@ QUANTITIES: dict[str, Quantity] = {
     "arm mode σ_a (1/s)": "arm",
 }
 RIGHT = 0.15  # the locus plots show Re λ up to this fraction of their left reach (unstable poles)
+TALL = 20.0  # ... and Im λ within this multiple of it
 BASE_COLOUR, ARM_COLOUR, NOW_COLOUR = "#e0503a", "#1f6fd1", "#111111"
 CHECK_S = 0.1  # s: the view is checked at 10 Hz (its changes come in bursts: gains, poles, authority)
 _SLIDER_MAX = {name: hi for name, _, _, hi, _, _ in GAIN_SLIDERS}
@@ -84,7 +85,7 @@ class GainExplorerView:
         self.server, self.session, self.gui = server, session, gui
         self.controls, self.connections = controls, connections
         g = server.gui
-        with g.add_folder("Gain explorer", expand_by_default=True):
+        with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
             g.add_markdown(
                 "**Gain map** in the scene (left of the robot): each cell is a (g_b, g_m) setting, coloured by "
                 "how fast the closed loop, linearised about the current pose, damps the chosen mode. "
@@ -173,8 +174,10 @@ class GainExplorerView:
             data = locus_data(locus, view.current, reach)
             if len(data[0]) < 2:
                 continue
-            shown = data[0] <= RIGHT * reach  # the y range fits the poles inside the x range
-            ims = np.concatenate([d[shown & np.isfinite(d)] for d in data[1:]])
+            # The y range fits the poles inside the x range up to TALL x reach (the 1 ms hold's poles
+            # near |Im| = pi/dt would squeeze the rest flat).
+            ims = np.abs(np.concatenate([d[np.isfinite(d)] for d in data[1:]]))
+            ims = ims[ims <= TALL * reach]
             top = 1.1 * max(float(np.max(np.abs(ims))) if len(ims) else 0.0, 0.1 * reach)
             plot.scales = {
                 "x": {"time": False, "auto": False, "range": (-reach, RIGHT * reach)},
@@ -224,16 +227,10 @@ def _same(parts: tuple[object, ...], drawn: object) -> bool:
 
 
 def _reach(view: GainView) -> float:
-    """How far left the locus plots reach (1/s): past the slowest few poles now, at least 1/s."""
-    now = view.current
-    if now is None:
-        return 10.0
-    rates = np.sort(-now.poles.real.ravel())
-    rates = rates[np.isfinite(rates)]
-    if len(rates) == 0:
-        return 10.0
-    base = -now.poles.real[now.is_base] if now.is_base.any() else rates
-    return float(max(1.0, 4.0 * np.max(base), 1.5 * rates[min(len(rates) - 1, 1)]))
+    """How far left the locus plots reach (1/s): six times the base mode's decay rate now, at least 1/s
+    (the slow poles are the interesting ones; the arm's fast ones are off the left edge)."""
+    rate = view.predicted
+    return float(max(1.0, 6.0 * rate)) if math.isfinite(rate) else 10.0
 
 
 def _fmt_rate(rate: float) -> str:

@@ -149,6 +149,7 @@ class GainScene:
             np.zeros((1, 3)),
             (0, 0, 0),
             point_size=0.6 * style.marker_radius,
+            point_shape="circle",
             precision="float32",
             visible=False,
         )
