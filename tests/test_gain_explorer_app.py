@@ -218,3 +218,21 @@ def test_after_a_kick_the_panel_sets_the_measured_decay_beside_the_prediction(ap
     wait_until(lambda: "measured" in ex.predicted.content, 10.0, "the panel to show the measured decay")
     text = ex.predicted.content
     assert f"{measured.rate:.3g} 1/s" in text and f"{s.gain_view().predicted:.3g} 1/s" in text
+
+
+def test_after_a_model_switch_the_new_models_map_is_drawn() -> None:
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    try:
+        assert app.session.wait_background()
+        app.session.switch_model("planar3r", None)
+
+        def redrawn() -> bool:
+            app.session.advance(0.01)
+            sc = explorer(app).scene
+            return app.model_name == "planar3r" and drawn(app) and sc is not None and "(15)" in sc.title.text
+
+        wait_until(redrawn, 60.0, "the 3R's gain map")
+        assert app.session.gain_view().model == "planar3r"
+        assert explorer(app).scene.authority.visible and not explorer(app).scene.authority_lines.visible
+    finally:
+        app.stop()
