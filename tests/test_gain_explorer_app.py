@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.gain_panel import GainExplorerView, locus_data
+from rns_viz.viz.gain_panel import QUANTITIES, GainExplorerView, locus_data
 from rns_viz.viz.gain_scene import GainScene, axis_fraction, colours, grid_point, map_image
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient
@@ -159,7 +159,8 @@ def test_the_drawn_authority_colours_are_the_predicted_rates(app: RnsApp) -> Non
     view = app.session.gain_view()
     scene = explorer(app).scene
     assert scene is not None and view.authority is not None and view.path_points is not None
-    expected = colours(view.authority.base_decay_rate, scene.scale)
+    assert scene.base_scale == scene.scale  # the base mode's map is shown: the path is coloured as the map
+    expected = colours(view.authority.base_decay_rate, scene.base_scale)
     expected[~view.authority.stable] = (90, 90, 90)
     if scene.authority_lines.visible:  # TREP: the current path, one segment per pair of points
         drawn_colours = np.asarray(scene.authority_lines.colors)
@@ -173,12 +174,23 @@ def test_the_drawn_authority_colours_are_the_predicted_rates(app: RnsApp) -> Non
         np.testing.assert_allclose(np.asarray(scene.authority.points)[:, :2], view.path_points[:, :2], atol=1e-6)
     # A rate that varies along the path shows as colours ordered like the rates (viridis: brighter = faster).
     auth = view.authority
-    ramp = np.geomspace(scene.scale[0], scene.scale[1], len(auth.base_decay_rate))[::-1]
+    ramp = np.geomspace(scene.base_scale[0], scene.base_scale[1], len(auth.base_decay_rate))[::-1]
     rgb = scene.show_authority(replace(view, authority=replace(auth, base_decay_rate=ramp)), app.model_name == "trep")
     assert rgb is not None
     luminance = rgb.astype(float) @ np.array([0.299, 0.587, 0.114])
     assert np.all(np.diff(luminance) <= 0) and luminance[0] - luminance[-1] > 100
     scene.show_authority(view, app.model_name == "trep")  # as it was
+    # The arm mode's map on show: the path keeps the base mode's colours.
+    ex = explorer(app)
+    before = np.asarray((scene.authority_lines if scene.authority_lines.visible else scene.authority).colors).copy()
+    app.controls.show(ex.quantity, next(k for k, q in QUANTITIES.items() if q == "arm"))
+    try:
+        wait_until(lambda: scene.legend.text.startswith("σ_a"), 10.0, "the arm mode's map")
+        after = np.asarray((scene.authority_lines if scene.authority_lines.visible else scene.authority).colors)
+        np.testing.assert_array_equal(after, before)
+    finally:
+        app.controls.show(ex.quantity, next(iter(QUANTITIES)))
+        wait_until(lambda: scene.legend.text.startswith("σ_b"), 10.0, "the base mode's map again")
 
 
 def test_map_image_marks_unstable_cells_and_clicks_map_to_cells(app: RnsApp) -> None:

@@ -260,6 +260,6 @@ def authority_text(view: GainView, on_path: bool) -> str:
         return f"Authority {where}: being computed…"
     r = auth.base_decay_rate
     return (
-        f"**Authority** {where}, coloured as the map: σ_b {np.min(r):.3g} … {np.max(r):.3g} 1/s at the gains in "
-        "force — flat except near singularities of H_bm, where suppression fades."
+        f"**Authority** {where}, coloured as the base mode's map: σ_b {np.min(r):.3g} … {np.max(r):.3g} 1/s "
+        "at the gains in force — flat except near singularities of H_bm, where suppression fades."
     )

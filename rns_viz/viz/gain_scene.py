@@ -143,7 +143,8 @@ class GainScene:
         self._paper: list[object] = []
         self._paper_key: tuple[tuple[str, float, float], ...] | None = None
         self.gain_map: GainMap | None = None
-        self.scale = (0.01, 1.0)  # 1/s, the map's colour scale (authority uses it too)
+        self.scale = (0.01, 1.0)  # 1/s, the colour scale of the map shown
+        self.base_scale = (0.01, 1.0)  # 1/s, that of the base mode's map (the authority's colours)
         self.authority = scene.add_point_cloud(
             self.AUTHORITY,
             np.zeros((1, 3)),
@@ -170,6 +171,7 @@ class GainScene:
             self.gain_map = None
             return
         image, self.scale = map_image(gm, quantity)
+        self.base_scale = colour_scale(gm.base_decay_rate, gm.stable)  # the authority's, whatever is shown
         new_axes = self.gain_map is None or not (
             np.array_equal(gm.g_b, self.gain_map.g_b) and np.array_equal(gm.g_m, self.gain_map.g_m)
         )
@@ -273,13 +275,13 @@ class GainScene:
     # -- authority along the path ----------------------------------------------------------------
     def show_authority(self, view: GainView, on_path: bool) -> np.ndarray | None:
         """Colour the current path (TREP) or the reachable-set points (3R) by the predicted base decay
-        rate (1/s) on the map's colour scale; returns the colours drawn (K, 3) or None."""
+        rate (1/s) on the base mode map's colour scale; returns the colours drawn (K, 3) or None."""
         pts, auth = view.path_points, view.authority
         if pts is None or auth is None or len(pts) != len(auth.base_decay_rate) or len(pts) < 2:
             self.authority.visible = self.authority_lines.visible = False
             return None
         rates = np.asarray(auth.base_decay_rate, dtype=float)
-        rgb = colours(rates, self.scale)
+        rgb = colours(rates, self.base_scale)
         rgb[~np.asarray(auth.stable)] = UNSTABLE_RGB
         st = self.style
         lifted = np.asarray(pts, dtype=float) + np.array([0.0, 0.0, st.overlay_z + 2 * st.line_thickness])
