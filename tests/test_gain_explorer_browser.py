@@ -91,3 +91,14 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
         wait_for_frames(page, 20)
         assert screenshot(page, f"gain_map_arm_{app.model_name}").stat().st_size > 10_000
         assert np.isfinite(app.session.gain_view().predicted)
+        if app.model_name == "trep":  # predicted vs measured, after a kick from the page's button
+            app.controls.show(ex.quantity, next(iter(QUANTITIES)))
+            page.get_by_role("button", name="Kick the base").click()
+            wait_until(lambda: app.session.gain_view().measured is not None, 30.0, "the measured decay")
+            wait_until(lambda: "measured" in ex.predicted.content, 10.0, "the panel to show it")
+            page.get_by_text("Map shows", exact=True).first.scroll_into_view_if_needed()  # (the text above re-renders)
+            dismiss_notifications(page)
+            wait_for_frames(page, 20)
+            assert screenshot(page, "gain_measured_trep").stat().st_size > 10_000
+            view = app.session.gain_view()
+            print(f"predicted {view.predicted:.3f} 1/s, measured {view.measured.rate:.3f} 1/s")

@@ -98,7 +98,7 @@ class GainExplorerView:
                 hint="Base mode: the poles a base kick excites; arm mode: the others (Sec. VIII: two subsystems).",
             )
             self.meaning = g.add_markdown("")
-            self.predicted = g.add_html("")
+            self.predicted = g.add_markdown("")
             self.authority = g.add_markdown("")
             self.locus_b = _locus_plot(g, "Root locus, g_b sweeps")
             self.locus_m = _locus_plot(g, "Root locus, g_m sweeps")
@@ -160,7 +160,7 @@ class GainExplorerView:
             self.meaning.content = f"*{view.g_m_meaning}.*"
             self.gui.gains["g_m"].hint = f"{_G_M_HINT} Here: {view.g_m_meaning}."
         for handle, text in (
-            (self.predicted, predicted_html(view)),
+            (self.predicted, predicted_text(view)),
             (self.authority, authority_text(view, self.on_path)),
         ):
             if handle.content != text:
@@ -241,15 +241,15 @@ def _fmt_rate(rate: float) -> str:
     return f"{rate:.3g} 1/s, 10 % in {LN10 / rate:.3g} s"
 
 
-def predicted_html(view: GainView) -> str:
+def predicted_text(view: GainView) -> str:
     """One line: predicted base decay at the gains in force, and after a kick the measured one."""
     gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
-    pred = f"<b>Base decay</b> at {gains}: predicted {_fmt_rate(view.predicted)}"
+    pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
     m = view.measured
     if m is None:
-        return f"<div>{pred}; <i>kick the base to measure it</i> (fit of |x_b| peaks, 4–20 s after the kick).</div>"
+        return f"{pred}; *kick the base to measure it* (fit of the |x_b| peaks, 4–20 s after the kick)."
     fit = f"fit over {m.seconds:.1f} s after the kick at t = {m.since:.1f} s"
-    return f"<div>{pred}; <b>measured</b> {_fmt_rate(m.rate)} ({fit}).</div>"
+    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({fit})."
 
 
 def authority_text(view: GainView, on_path: bool) -> str:
