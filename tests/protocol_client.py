@@ -119,6 +119,25 @@ class ProtocolClient:
         if message_type is not None:
             self._send(message_type(name))
 
+    def scene_click(
+        self,
+        name: str,
+        ray_origin: tuple[float, ...],
+        ray_direction: tuple[float, ...],
+        screen_pos: tuple[float, float] = (0.5, 0.5),
+    ) -> None:
+        """A click on scene node ``name`` (viser's SceneNodeClickMessage): the ray in world coordinates."""
+        self._send(
+            _messages.SceneNodeClickMessage(
+                name=name,
+                instance_index=None,
+                ray_origin=tuple(ray_origin),  # type: ignore[arg-type]
+                ray_direction=tuple(ray_direction),  # type: ignore[arg-type]
+                screen_pos=screen_pos,
+                modifier=None,
+            )
+        )
+
     # -- receiving -----------------------------------------------------------------------------
     def _drain(self) -> None:
         try:

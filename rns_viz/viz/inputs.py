@@ -128,6 +128,8 @@ class Controls:
             self._good[id(handle)] = handle.value
             handle.on_update(callback)
 
+    on_input = _on_input  # for panels built elsewhere (viz/gain_panel.py)
+
     def _wire(self) -> None:
         g, s = self.gui, self.session
         self._on_input(g.kick, lambda _, c: s.kick(float(self.good(g.kick_peak)), c), button=True)

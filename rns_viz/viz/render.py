@@ -21,6 +21,7 @@ from rns_viz.live.records import Snapshot
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
 from rns_viz.viz.connections import Connections
+from rns_viz.viz.gain_panel import GainExplorerView
 from rns_viz.viz.gui import (
     EXAGGERATION,
     KICK_PEAK,
@@ -68,6 +69,7 @@ class Renderer:
         self.plot_updates = 0
         snap = session.snapshot()
         self.model_name = snap.settings.model
+        self.explorer = GainExplorerView(server, session, gui, controls, connections)
         self._build_scene(snap)
         self._seen = _Seen()
         self.sync_settings(snap)
@@ -103,6 +105,7 @@ class Renderer:
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
         self.scene.set_target(snap.target)
+        self.explorer.build_scene(self.scene.style, self.model.n - len(self.model.selected) == 1)
 
     def _home(self, snap: Snapshot) -> np.ndarray:
         """Where the target handle rests: the session's target, else the end effector."""
@@ -152,6 +155,7 @@ class Renderer:
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
             self._draw_overlays()
+        self.explorer.frame()  # the gain map, loci and authority, when the gain view changed
         if self.controls.take_handle_home_request():
             seen.target_version = -1
         self._draw_target(snap)

@@ -1,0 +1,265 @@
+"""The gain explorer in the app (issue 10): panel folder, root loci, and the map in the scene.
+
+:class:`GainExplorerView` is built once with the panel; the renderer hands it each model's scene
+(:meth:`build_scene`) and calls :meth:`frame` every frame, which redraws only when
+``session.gain_view().version`` changed. A click on the map applies the clicked grid point's
+(g_b, g_m) through ``Session.set_gains``; only the operator's clicks count.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+
+import numpy as np
+import viser
+import viser.uplot
+
+from rns_viz.analysis import GAIN_RANGE, Locus, Modes
+from rns_viz.live.gain_explorer import GainView
+from rns_viz.live.session import Session
+from rns_viz.viz.connections import Connections
+from rns_viz.viz.gain_scene import LN10, GainScene, Quantity
+from rns_viz.viz.gui import GAIN_SLIDERS, GuiElements
+from rns_viz.viz.inputs import Controls
+from rns_viz.viz.style import SceneStyle
+
+QUANTITIES: dict[str, Quantity] = {
+    "base mode σ_b (1/s)": "base",
+    "base mode time to 10 % (s)": "time",
+    "arm mode σ_a (1/s)": "arm",
+}
+RIGHT = 0.15  # the locus plots show Re λ up to this fraction of their left reach (unstable poles)
+TALL = 20.0  # ... and Im λ within this multiple of it
+BASE_COLOUR, ARM_COLOUR, NOW_COLOUR = "#e0503a", "#1f6fd1", "#111111"
+CHECK_S = 0.1  # s: the view is checked at 10 Hz (its changes come in bursts: gains, poles, authority)
+_SLIDER_MAX = {name: hi for name, _, _, hi, _, _ in GAIN_SLIDERS}
+_G_M_HINT = next(h for name, *_, h in GAIN_SLIDERS if name == "g_m")
+
+
+def _locus_plot(gui: viser.GuiApi, title: str) -> viser.GuiUplotHandle:
+    series: list[viser.uplot.Series] = [{"label": "Re λ (1/s)"}]
+    for label, colour, size in (("base mode", BASE_COLOUR, 4), ("arm modes", ARM_COLOUR, 4), ("now", NOW_COLOUR, 9)):
+        series.append(
+            {
+                "label": label,
+                "stroke": colour,
+                "width": 0,
+                "points": {"show": True, "size": size, "stroke": colour, "fill": colour},
+            }
+        )
+    return gui.add_uplot(
+        data=tuple(np.zeros(2) for _ in range(4)),
+        series=tuple(series),
+        title=title,
+        scales={"x": {"time": False, "auto": False, "range": (-1.0, 0.1)}, "y": {"auto": False, "range": (-1.0, 1.0)}},
+        axes=({"label": "Re λ (1/s)"}, {"label": "Im λ (1/s)", "size": 60}),
+        legend={"show": True, "live": False},
+        cursor={"show": False},
+        aspect=1.3,
+    )
+
+
+def locus_data(locus: Locus, now: Modes | None, reach: float) -> tuple[np.ndarray, ...]:
+    """uPlot data (x, base, arm, now) of a root locus: x sorted Re λ (1/s), NaN where a series has no point."""
+    re, im = locus.poles.real.ravel(), locus.poles.imag.ravel()
+    base = locus.is_base.ravel()
+    n_re = np.zeros(0) if now is None else now.poles.real.ravel()
+    n_im = np.zeros(0) if now is None else now.poles.imag.ravel()
+    x = np.concatenate([re, n_re])
+    cols = np.full((3, len(x)), np.nan)
+    cols[0, : len(re)] = np.where(base, im, np.nan)
+    cols[1, : len(re)] = np.where(base, np.nan, im)
+    cols[2, len(re) :] = n_im
+    keep = np.isfinite(x) & (x >= -reach) & (x <= RIGHT * reach)
+    order = np.argsort(x[keep], kind="stable")
+    return (x[keep][order], *(c[keep][order] for c in cols))
+
+
+class GainExplorerView:
+    """The explorer's panel folder and scene; redrawn when the session's gain view changes."""
+
+    def __init__(self, server: viser.ViserServer, session: Session, gui: GuiElements, controls: Controls,
+                 connections: Connections) -> None:  # fmt: skip
+        self.server, self.session, self.gui = server, session, gui
+        self.controls, self.connections = controls, connections
+        g = server.gui
+        with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
+            g.add_markdown(
+                "**Gain map** in the scene (left of the robot): each cell is a (g_b, g_m) setting, coloured by "
+                "how fast the closed loop, linearised about the current pose, damps the chosen mode. "
+                "**Click a cell** to apply its gains."
+            )
+            self.quantity = g.add_dropdown(
+                "Map shows",
+                tuple(QUANTITIES),
+                initial_value=next(iter(QUANTITIES)),
+                hint="Base mode: the poles a base kick excites; arm mode: the others (Sec. VIII: two subsystems).",
+            )
+            self.meaning = g.add_markdown("")
+            self.predicted = g.add_markdown("")
+            self.authority = g.add_markdown("")
+            self.locus_b = _locus_plot(g, "Root locus, g_b sweeps")
+            self.locus_m = _locus_plot(g, "Root locus, g_m sweeps")
+            g.add_markdown(
+                "Closed-loop poles λ (1/s); further left decays faster. Fast poles off the left edge are not shown."
+            )
+        controls.on_input(self.quantity, lambda v, c: None)  # read below; watchers are refused and reverted
+        self.scene: GainScene | None = None
+        self.on_path = True
+        self._version = -1
+        self._quantity = ""
+        self._law = ""
+        self.clicks_applied = 0
+        self._next_check = 0.0
+        self._drawn: dict[str, object] = {}
+        self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
+
+    def build_scene(self, style: SceneStyle, on_path: bool) -> None:
+        """The model's scene was (re)built: add the map to it."""
+        self.scene = GainScene(self.server, style, self._on_point)
+        self.on_path = on_path
+        self._version = -1
+        self._drawn = {}
+
+    # -- per frame -------------------------------------------------------------------------------
+    def frame(self) -> None:
+        now = time.perf_counter()
+        if now < self._next_check:
+            return
+        self._next_check = now + CHECK_S
+        view = self.session.gain_view()
+        quantity = QUANTITIES.get(self.controls.good(self.quantity), "base")
+        if self.scene is None or (view.version == self._version and quantity == self._quantity):
+            return
+        map_changed = view.map is not self.scene.gain_map or quantity != self._quantity
+        self._version, self._quantity = view.version, quantity
+        if map_changed:
+            self.scene.show_map(view, quantity)
+        else:
+            self.scene.show_now(view)
+        drawn = self._drawn  # send only what changed: the parts of a view are new objects when they change
+        if map_changed or not _same((view.authority, view.path_points), drawn.get("authority")):
+            drawn["authority"] = (view.authority, view.path_points)
+            self.scene.show_authority(view, self.on_path)
+        self._show_text(view)
+        if not _same((view.locus_g_b, view.locus_g_m, view.current), drawn.get("loci")):
+            drawn["loci"] = (view.locus_g_b, view.locus_g_m, view.current)
+            self._show_loci(view)
+        self._widen_sliders(view)
+        clicked = self._clicked
+        if clicked is not None and clicked == (view.gains.g_b, view.gains.g_m):
+            self._clicked = None  # in force: the sliders show it (the session only re-syncs them after
+            self.controls.show(self.gui.gains["g_b"], clicked[0])  # input other than the operator's)
+            self.controls.show(self.gui.gains["g_m"], clicked[1])
+
+    def _show_text(self, view: GainView) -> None:
+        if view.law != self._law and view.g_m_meaning:
+            self._law = view.law
+            self.meaning.content = f"*{view.g_m_meaning}.*"
+            self.gui.gains["g_m"].hint = f"{_G_M_HINT} Here: {view.g_m_meaning}."
+        for handle, text in (
+            (self.predicted, predicted_text(view)),
+            (self.authority, authority_text(view, self.on_path)),
+        ):
+            if handle.content != text:
+                handle.content = text
+
+    def _show_loci(self, view: GainView) -> None:
+        reach = _reach(view)
+        for plot, locus, other in ((self.locus_b, view.locus_g_b, "g_m"), (self.locus_m, view.locus_g_m, "g_b")):
+            if locus is None:
+                continue
+            data = locus_data(locus, view.current, reach)
+            if len(data[0]) < 2:
+                continue
+            # The y range fits the poles inside the x range up to TALL x reach (the 1 ms hold's poles
+            # near |Im| = pi/dt would squeeze the rest flat).
+            ims = np.abs(np.concatenate([d[np.isfinite(d)] for d in data[1:]]))
+            ims = ims[ims <= TALL * reach]
+            top = 1.1 * max(float(np.max(np.abs(ims))) if len(ims) else 0.0, 0.1 * reach)
+            plot.scales = {
+                "x": {"time": False, "auto": False, "range": (-reach, RIGHT * reach)},
+                "y": {"auto": False, "range": (-top, top)},
+            }
+            plot.data = data
+            lo, hi = locus.values[0], locus.values[-1]
+            plot.title = f"Root locus: {locus.sweep} {lo:g}…{hi:g} 1/s at {other} = {locus.fixed:.4g} 1/s"
+
+    def _widen_sliders(self, view: GainView) -> None:
+        """A map click can apply gains beyond a slider's default range: widen it to the map's range."""
+        top = GAIN_RANGE.get(view.law, (0.0, 3000.0))[1]
+        for name in ("g_b", "g_m"):
+            slider, value = self.gui.gains[name], float(getattr(view.gains, name))
+            wanted = _SLIDER_MAX[name] if value <= _SLIDER_MAX[name] else top
+            if slider.max != wanted:
+                slider.max = wanted
+
+    # -- a click on the map ----------------------------------------------------------------------
+    def _on_point(self, client: viser.ClientHandle | None, origin: object, direction: object) -> None:
+        """A scene click on the map image: apply its grid point's gains if the client operates."""
+        try:
+            if not self.connections.allowed(client):
+                self.connections.refuse_watcher(client)
+                return
+            scene = self.scene
+            point = None if scene is None else scene.clicked_gains(origin, direction)
+            if point is None:
+                self.connections.notify(client, "Gains not applied", "The click was not on the gain map.", "warning")
+                return
+            g_b, g_m = point
+            self._clicked = point
+            self.session.set_gains(None if client is None else client.client_id, g_b=g_b, g_m=g_m)
+            self.clicks_applied += 1
+        except ValueError as exc:
+            self.connections.notify(client, "Gains not applied", str(exc), "warning")
+        except Exception as exc:  # a click must never take the server down
+            traceback.print_exc()
+            self.connections.notify(client, "Gains not applied", f"{type(exc).__name__}: {exc}", "error")
+
+
+def _same(parts: tuple[object, ...], drawn: object) -> bool:
+    """The very objects drawn last (identity: the view's parts are immutable, new when changed)."""
+    return (
+        isinstance(drawn, tuple) and len(drawn) == len(parts) and all(a is b for a, b in zip(parts, drawn, strict=True))
+    )
+
+
+def _reach(view: GainView) -> float:
+    """How far left the locus plots reach (1/s): six times the base mode's decay rate now, at least 1/s
+    (the slow poles are the interesting ones; the arm's fast ones are off the left edge)."""
+    rate = view.predicted
+    return float(max(1.0, 6.0 * rate)) if math.isfinite(rate) else 10.0
+
+
+def _fmt_rate(rate: float) -> str:
+    if not math.isfinite(rate):
+        return "…"
+    if rate <= 0:
+        return f"{rate:.3g} 1/s (grows)"
+    return f"{rate:.3g} 1/s, 10 % in {LN10 / rate:.3g} s"
+
+
+def predicted_text(view: GainView) -> str:
+    """One line: predicted base decay at the gains in force, and after a kick the measured one."""
+    gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
+    pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+    m = view.measured
+    if m is None:
+        return f"{pred}; *kick the base to measure it* (fit of the |x_b| peaks, 4–20 s after the kick)."
+    fit = f"fit over {m.seconds:.1f} s after the kick at t = {m.since:.1f} s"
+    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({fit})."
+
+
+def authority_text(view: GainView, on_path: bool) -> str:
+    """One line: the range of the predicted base decay rate along the path (TREP) or over the set (3R)."""
+    where = "along the current reactionless path" if on_path else "over the reactionless-reachable set (dots)"
+    auth = view.authority
+    if auth is None or len(auth.base_decay_rate) == 0:
+        return f"Authority {where}: being computed…"
+    r = auth.base_decay_rate
+    return (
+        f"**Authority** {where}, coloured as the base mode's map: σ_b {np.min(r):.3g} … {np.max(r):.3g} 1/s "
+        "at the gains in force — flat except near singularities of H_bm, where suppression fades."
+    )
