@@ -18,6 +18,8 @@ import pytest
 import viser
 from playwright.sync_api import Page, sync_playwright
 
+from rns_viz.viz.app import RnsApp, start_app
+
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_FLAGS = [
     "--headless",
@@ -147,3 +149,11 @@ def screenshot(page: Page, name: str) -> Path:
     path = ARTIFACTS / f"{name}.png"
     page.screenshot(path=str(path))
     return path
+
+
+@pytest.fixture(params=["trep", "planar3r"], name="app")
+def each_model_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
+    """The app of each bundled planar model on a free port (import this fixture into a test module)."""
+    app = start_app(request.param, port=0, verbose=False)
+    yield app
+    app.stop()

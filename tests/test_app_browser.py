@@ -5,16 +5,16 @@ with the server's state checked after each action. Screenshots go to artifacts/a
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import pytest
 from playwright.sync_api import Page
 
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
+from rns_viz.viz.app import TARGET_HANDLE, RnsApp
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
     browser_page,
     dismiss_notifications,
+    each_model_app,  # noqa: F401 (the fixture 'app')
     requires_chromium,
     screenshot,
     wait_for_frames,
@@ -23,13 +23,6 @@ from tests.browser import (
 )
 
 pytestmark = [pytest.mark.browser, requires_chromium]
-
-
-@pytest.fixture(params=["trep", "planar3r"])
-def app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
-    app = start_app(request.param, port=0, verbose=False)
-    yield app
-    app.stop()
 
 
 def click_track(page: Page, label: str, fraction: float) -> None:

@@ -3,18 +3,17 @@ on it applies the cell's gains, and screenshots go to artifacts/gain_map_<model>
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import numpy as np
 import pytest
 from playwright.sync_api import Page
 
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.app import RnsApp
 from rns_viz.viz.gain_panel import QUANTITIES
 from rns_viz.viz.gain_scene import GainScene, axis_fraction
 from tests.browser import (
     browser_page,
     dismiss_notifications,
+    each_model_app,  # noqa: F401 (the fixture 'app')
     requires_chromium,
     screenshot,
     wait_for_frames,
@@ -23,13 +22,6 @@ from tests.browser import (
 )
 
 pytestmark = [pytest.mark.browser, requires_chromium]
-
-
-@pytest.fixture(params=["trep", "planar3r"])
-def app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
-    app = start_app(request.param, port=0, verbose=False)
-    yield app
-    app.stop()
 
 
 def screen_point(page: Page, local: tuple[float, float, float]) -> tuple[float, float] | None:
