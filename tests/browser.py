@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 import viser
+from playwright.sync_api import Error as PlaywrightError
 from playwright.sync_api import Page, sync_playwright
 
 from rns_viz.viz.app import RnsApp, start_app
@@ -113,7 +114,10 @@ def dismiss_notifications(page: Page) -> None:
     """Close the client's toasts (e.g. "Software WebGL rendering detected") before a screenshot."""
     buttons = page.locator(".mantine-Notification-closeButton")
     for k in reversed(range(buttons.count())):
-        buttons.nth(k).click()
+        try:  # a toast may close itself (or be replaced) while we reach for it: then it is gone anyway
+            buttons.nth(k).click(timeout=2000)
+        except PlaywrightError:
+            continue
 
 
 def wait_for_nodes(page: Page, names: set[str], timeout: float = 30.0) -> None:

@@ -34,9 +34,8 @@ from rns_viz.scenarios import (
     boom7_track,
 )
 from rns_viz.sim import Simulator
-from rns_viz.sim.disturbance import ForceInput
 from rns_viz.sim.plant import Plant
-from tests.oracles.mujoco_replay import replay
+from tests.oracles.mujoco_replay import HeldOverEachStep, replay
 
 RUN_S = BOOM7_START_S + BOOM7_MOVE_S + 0.1  # s: every motion is over by then
 # The boom of boom7.toml: aluminium tube, E, G in Pa, length, outer diameter and wall in m.
@@ -205,21 +204,6 @@ def test_kick_is_suppressed_in_all_six_modes(kicked: Simulator) -> None:
     assert np.all(on <= 0.01 * off)
     theta = columns(kicked, "theta", 7)
     assert np.all((theta >= kicked.model.lower) & (theta <= kicked.model.upper))
-
-
-class HeldOverEachStep:
-    """A force input held over each step at its value at the step's start: what MuJoCo's mj_step
-    applies (qfrc_applied is constant over its four RK4 stages), while our step samples the force at
-    the stage times t, t + dt/2, t + dt. The simulator asks for those three in that order."""
-
-    def __init__(self, inner: ForceInput) -> None:
-        self.inner, self.calls, self.held = inner, 0, None
-
-    def __call__(self, t: float) -> np.ndarray | None:
-        if self.calls % 3 == 0:
-            self.held = self.inner(t)
-        self.calls += 1
-        return self.held
 
 
 def test_mujoco_replay_of_the_3d_kick_reproduces_all_six_deflections(boom7: FsmsModel) -> None:

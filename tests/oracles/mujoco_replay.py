@@ -50,7 +50,7 @@ Pinocchio is used for nothing but that list of joint names.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -307,3 +307,18 @@ def replay(
     """
     plant = build_model(urdf_path, base_joints, stiffness, damping, joint_damping, dt)
     return simulate(plant, q0, v0, torques, base_forces)
+
+
+class HeldOverEachStep:
+    """A force input held over each step at its value at the step's start: what mj_step applies
+    (qfrc_applied is constant over its four RK4 stages), while rns_viz's step samples the force at
+    the stage times t, t + dt/2, t + dt. The simulator asks for those three in that order."""
+
+    def __init__(self, inner: Callable[[float], np.ndarray | None]) -> None:
+        self.inner, self.calls, self.held = inner, 0, None
+
+    def __call__(self, t: float) -> np.ndarray | None:
+        if self.calls % 3 == 0:
+            self.held = self.inner(t)
+        self.calls += 1
+        return self.held
