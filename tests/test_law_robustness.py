@@ -18,7 +18,7 @@ from rns_viz.control import (
     FixedReference,
     Gains,
     JointServo,
-    MovableTarget,
+    TaskSample,
     TorqueLaw,
     TrackEndEffector,
     VelocityLaw,
@@ -91,7 +91,7 @@ def test_every_law_stays_finite_and_physical(name: str) -> None:
         theta = special[k % len(special)] if k % 7 == 0 else rng.uniform(-2 * np.pi, 2 * np.pi, model.n)
         q = np.concatenate([rng.uniform(-0.1, 0.1, m), theta])
         v = rng.normal(scale=10.0 ** rng.uniform(-3, 1.5), size=model.nv)
-        target = MovableTarget(rng.uniform(-5, 5, 2))
+        target = TaskSample.held(rng.uniform(-5, 5, 2))
         reference = FixedReference(rng.uniform(-np.pi, np.pi, model.n))
         plant.at(q, v)
         H = plant.H_bm[selected]

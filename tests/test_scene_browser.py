@@ -27,7 +27,7 @@ from tests.browser import (
 pytestmark = [pytest.mark.browser, requires_chromium]
 
 DEFLECTION = {"trep": 0.004, "planar3r": 0.1}  # m, x_b shown (times EXAGGERATION) in the screenshot
-EXAGGERATION = {"trep": 10.0, "planar3r": 2.0}
+EXAGGERATION = {"trep": 10.0, "planar3r": 2.0}  # drawn deflection factor set for the screenshot
 FORCE = {"trep": 0.3, "planar3r": 40.0}  # N
 
 

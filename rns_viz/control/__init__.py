@@ -5,7 +5,6 @@ from rns_viz.control.common import ControlLaw, ControlOutput, Gains, InvalidGain
 from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.null_input import (
     DampNullMotion,
-    MovableTarget,
     TaskQuintic,
     TrackEndEffector,
     TrackJointReference,
@@ -33,7 +32,6 @@ __all__ = [
     "JointSample",
     "JointServo",
     "LawKind",
-    "MovableTarget",
     "PathReference",
     "ReferenceSample",
     "Switched",

@@ -133,14 +133,3 @@ class TrackEndEffector:
 
 
 TaskQuintic = QuinticSegment  # straight end-effector path, quintic in time (Fig. 4)
-
-
-@dataclass
-class MovableTarget:
-    """A target the operator moves (the app's drag handle): fixed point, zero rates."""
-
-    position: np.ndarray
-
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        zero = np.zeros_like(self.position)
-        return self.position.copy(), zero, zero

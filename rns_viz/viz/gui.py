@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import viser
 import viser.uplot
 
+from rns_viz.defaults import defaults_for
 from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
@@ -23,9 +24,6 @@ MODEL_LABELS = {"trep": "TREP (2R on a flexible beam)", "planar3r": "planar 3R o
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
 PLANAR3R_PRESETS = ("fig3", "fig4")
-KICK_RANGE = {"trep": 5.0, "planar3r": 50.0}  # N, slider half range
-KICK_PEAK = {"trep": 0.8, "planar3r": 5.0}  # N, the slider's initial value
-EXAGGERATION = {"trep": 10.0, "planar3r": 20.0}  # default drawn deflection factor
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
@@ -124,10 +122,10 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         )
         kick_peak = gui.add_slider(
             "Kick peak (N)",
-            min=-KICK_RANGE[model],
-            max=KICK_RANGE[model],
+            min=-defaults_for(model).kick_range_N,
+            max=defaults_for(model).kick_range_N,
             step=0.1,
-            initial_value=KICK_PEAK[model],
+            initial_value=defaults_for(model).kick_peak_N,
             hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R).",
         )
         suppression = gui.add_checkbox(
@@ -240,7 +238,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             min=1.0,
             max=100.0,
             step=1.0,
-            initial_value=EXAGGERATION[model],
+            initial_value=defaults_for(model).exaggeration,
             hint="The base deflection is drawn this many times larger than simulated.",
         )
         speed = gui.add_dropdown(

@@ -15,6 +15,7 @@ from collections.abc import Callable
 import numpy as np
 import viser
 
+from rns_viz.defaults import defaults_for
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Snapshot
@@ -23,9 +24,6 @@ from rns_viz.model import FsmsModel
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gain_panel import GainExplorerView
 from rns_viz.viz.gui import (
-    EXAGGERATION,
-    KICK_PEAK,
-    KICK_RANGE,
     MODEL_LABELS,
     SPEED_LABELS,
     GuiElements,
@@ -119,9 +117,10 @@ class Renderer:
         self._build_scene(snap)
         g, controls = self.gui, self.controls
         with controls.quiet():
-            g.kick_peak.min, g.kick_peak.max = -KICK_RANGE[self.model_name], KICK_RANGE[self.model_name]
-        controls.show(g.kick_peak, KICK_PEAK[self.model_name])
-        controls.show(g.exaggeration, EXAGGERATION[self.model_name])
+            defaults = defaults_for(self.model_name)
+            g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
+        controls.show(g.kick_peak, defaults.kick_peak_N)
+        controls.show(g.exaggeration, defaults.exaggeration)
         self._seen = _Seen()
         self.sync_settings(snap)
 
