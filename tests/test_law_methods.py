@@ -15,7 +15,6 @@ from rns_viz.control import (
     Gains,
     JointSample,
     JointServo,
-    MovableTarget,
     Switched,
     TaskSample,
     TorqueLaw,
@@ -82,7 +81,7 @@ def test_retune_of_g_b_changes_theta_ddot_along_h_pinv(trep: FsmsModel) -> None:
 
 def test_retune_reaches_the_tracking_inputs(planar3r: FsmsModel) -> None:
     joint = TrackJointReference(FixedReference(planar3r.spec.default_configuration), 1.0, 1.0)
-    target = TrackEndEffector(planar3r, MovableTarget(np.zeros(2)), 1.0, 1.0)
+    target = TrackEndEffector(planar3r, TaskSample.held(np.zeros(2)), 1.0, 1.0)
     AccelerationLaw(planar3r, Gains(), joint).retune(Gains(k_p=7.0, k_d=3.0))
     TorqueLaw(planar3r, Gains(), target).retune(Gains(G_p=70.0, G_d=30.0))
     assert (joint.k_p, joint.k_d) == (7.0, 3.0)
@@ -174,7 +173,7 @@ def test_follow_of_the_wrong_sample_raises(trep: FsmsModel) -> None:
         (AccelerationLaw(trep, Gains()), joint),  # the default input damps; it tracks nothing
         (AccelerationLaw(trep, Gains()), task),
         (TorqueLaw(trep, Gains(), TrackJointReference(FixedReference(theta0), 1.0, 1.0)), task),
-        (AccelerationLaw(trep, Gains(), TrackEndEffector(trep, MovableTarget(np.zeros(2)), 1.0, 1.0)), joint),
+        (AccelerationLaw(trep, Gains(), TrackEndEffector(trep, TaskSample.held(np.zeros(2)), 1.0, 1.0)), joint),
         (VelocityLaw(trep, Gains(), FixedReference(theta0)), task),
         (JointServo(trep, Gains(), FixedReference(theta0)), task),
     ]
