@@ -28,6 +28,20 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
     return H, float(np.linalg.svd(H, compute_uv=False)[-1]), float(s_j[k - 1]) if k >= 1 else float("nan"), rns_dim
 
 
+def null_motion(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For a 1-D RNS at theta: n (kg m, Eq. 27) and the end-effector velocity J n it makes (3-vector,
+    base frame, m/s per unit u-bar), the arrow the teaching view draws."""
+    n = null_vector(model.coupling_matrix(model.q(theta)))
+    jn = np.zeros(3)
+    jn[model.task_rows] = model.ee_jacobian(theta) @ n
+    return n, jn
+
+
+def coupling_sigma(model: FsmsModel, theta: np.ndarray) -> float:
+    """Smallest singular value of S H_bm at theta, kg m: the arm's authority over the base."""
+    return _sigmas(model, np.asarray(theta, dtype=float))[1]
+
+
 @cache
 def _warning_levels(name: str) -> tuple[float, float]:
     """10 % of both distances at the model's default configuration: below that the GUI warns."""

@@ -259,9 +259,9 @@ class LiveState:
             case c.StartLesson(model=model, number=number):
                 lesson = LessonRun(model, number)
                 start = lesson.lesson.start
-                for step in (c.SwitchModel(start.model), c.SetLaw(start.law), c.SetSuppression(start.suppress)):
+                loads = (c.SwitchModel(start.model), c.SetLaw(start.law), c.SetSuppression(start.suppress))
+                for step in (*loads, c.SetShadow(True)):
                     self._apply(step)
-                self._apply(c.SetShadow(True))
                 self.lesson = lesson
             case c.StopLesson():
                 self.lesson = None

@@ -10,10 +10,9 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from rns_viz.live.readouts import arm_reach
+from rns_viz.live.readouts import arm_reach, coupling_sigma, null_motion
 from rns_viz.live.records import Snapshot
 from rns_viz.model import FsmsModel
-from rns_viz.rns import null_vector
 from rns_viz.viz.ghost import Ghost
 from rns_viz.viz.region_outline import outline_points
 from rns_viz.viz.scene import PATH_HIGHLIGHT, FsmsScene
@@ -73,12 +72,11 @@ class TeachScene:
         self.one_d = model.n - len(model.selected) == 1  # a 1-D reaction null space: n and a path exist
         reach = arm_reach(model)
         theta0 = model.spec.default_configuration
-        H0 = model.coupling_matrix(model.q(theta0))
         # Fixed scales per model (m of arrow per unit): the start pose draws n at 40 % of the reach
         # and L at the force arrow's full length for a joint rate of 1 rad/s.
-        jn0 = float(np.linalg.norm(model.ee_jacobian(theta0) @ null_vector(H0))) if self.one_d else 1.0
+        jn0 = float(np.linalg.norm(null_motion(model, theta0)[1])) if self.one_d else 1.0
         self.n_scale = 0.4 * reach / max(jn0, 1e-12)  # m per (m/s per unit u-bar)
-        self.L_scale = st.force_arrow_max / max(float(np.linalg.svd(H0, compute_uv=False)[-1]) * L_REF_RATE, 1e-12)
+        self.L_scale = st.force_arrow_max / max(coupling_sigma(model, theta0) * L_REF_RATE, 1e-12)
         self._L_origin = np.asarray(st.force_origin) + np.array([0.0, 0.0, 2.5 * r])
         self._axis = model.base_axes()[0] if model.base_is_translational else np.array([1.0, 0.0, 0.0])
         # What was drawn (tests read these): n (kg m) and J n (m/s per unit u-bar) at the drawn theta, L (kg m/s).
@@ -146,10 +144,7 @@ class TeachScene:
             return
         self._theta = theta
         model = self.model
-        n = null_vector(model.coupling_matrix(model.q(theta)))  # kg m, Eq. (27)
-        J = model.ee_jacobian(theta)  # (p, n) base frame, m/rad
-        jn = np.zeros(3)
-        jn[model.task_rows] = J @ n  # m/s per unit u-bar
+        n, jn = null_motion(model, theta)  # kg m (Eq. 27); m/s per unit u-bar
         self.n, self.jn = n, jn
         ee = model.ee_position(theta) + np.array([0.0, 0.0, self.scene.style.overlay_z])
         tip = ee + self.n_scale * jn
