@@ -59,11 +59,14 @@ def serve(model: str, teach: str | None = None) -> None:
     from rns_viz.viz.view_toggles import TOGGLES
 
     out, sys.stdout = sys.stdout, sys.stderr  # viser prints a banner: keep the protocol pipe clean
+    if teach == "off":  # the baseline records nothing (its ring buffer is never even allocated)
+        from rns_viz.live.recorder import Recorder
+
+        Recorder.append = lambda *args: None  # type: ignore[method-assign]
     app = start_app(model, port=0, verbose=False)
     recorder = app.session.state.outputs.recorder
     if teach == "off":
         app.view.show_only(())
-        recorder.append = lambda *args: None  # type: ignore[method-assign]  # the baseline records nothing
     elif teach == "on":
         app.view.show_only([name for name, *_ in TOGGLES])
     g = app.gui

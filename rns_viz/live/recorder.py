@@ -231,10 +231,15 @@ class Recorder:
 
     def _configure(self, runs: RunPair) -> None:
         log = runs.sim.log
-        shadow_names = [c for c in log.columns if c.rsplit("_", 1)[0] in _SHADOW]
+        # The shadow's columns kept: two contiguous runs of its log row (state and torque; L), cheap to copy.
+        i = log.index
+        n, r = runs.model.n, len(runs.model.selected)
+        self._shadow_blocks = (slice(1, i["tau_1"] + n), slice(i["L_1"], i["L_1"] + r))
+        shadow_names = [c for block in self._shadow_blocks for c in log.columns[block]]
+        assert all(c.rsplit("_", 1)[0] in _SHADOW for c in shadow_names)
         columns = (*log.columns, *(f"shadow_{c}" for c in shadow_names), *EXTRA)
-        self._log_width = len(log.columns)
-        self._shadow_cols = np.array([log.index[c] for c in shadow_names])
+        self._log_width = w = len(log.columns)
+        self._shadow_into = (slice(w, w + i["tau_1"] + n - 1), slice(w + i["tau_1"] + n - 1, len(columns) - len(EXTRA)))
         capacity = round(self.seconds / runs.sim.dt)
         if self._data is None or columns != self.columns or len(self._data) != capacity:
             self._data = np.full((capacity, len(columns)), np.nan)
@@ -257,13 +262,14 @@ class Recorder:
         data = self._data
         assert data is not None
         row = data[self._next]
-        w = self._log_width
-        row[:w] = row_log
+        row[: self._log_width] = row_log
+        (state, coupling), (state_to, coupling_to) = self._shadow_blocks, self._shadow_into
         shadow = runs.shadow.log.newest() if shadow_on else None
         if shadow is not None and shadow[0] == row_log[0]:
-            row[w : w + len(self._shadow_cols)] = shadow[self._shadow_cols]
+            row[state_to] = shadow[state]
+            row[coupling_to] = shadow[coupling]
         else:
-            row[w : w + len(self._shadow_cols)] = np.nan
+            row[state_to.start : coupling_to.stop] = np.nan
         row[-2] = reaction
         row[-1] = 1.0 if suppress else 0.0
         self._next = (self._next + 1) % len(data)
