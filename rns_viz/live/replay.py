@@ -24,6 +24,8 @@ from rns_viz.live.records import ReplayView, Snapshot
 from rns_viz.live.runs import RunPair
 from rns_viz.model import FsmsModel
 
+SEEK_SLACK_S = 0.01  # s: a seek this close outside the recording goes to its end (the timeline's resolution)
+
 
 class ReplayHost(Protocol):
     """What the replay touches of the loop's state (:class:`~rns_viz.live.state.LiveState`)."""
@@ -62,7 +64,7 @@ def apply_replay(state: ReplayHost, cmd: c.Command) -> bool:
     match cmd:
         case c.SeekReplay(t=t):
             t0, t1 = view.recording.span
-            if not t0 - 1e-9 <= t <= t1 + 1e-9:
+            if not t0 - SEEK_SLACK_S <= t <= t1 + SEEK_SLACK_S:
                 raise InputRefused(f"replay time must be within the recording, {t0:.3f} s to {t1:.3f} s; got {t:g} s")
             view = replace(view, start=min(max(t, t0), t1))
         case c.SetReplaySpeed(speed=speed):

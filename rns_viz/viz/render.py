@@ -141,9 +141,10 @@ class Renderer:
             self._stop.wait(max(0.0, delay))
 
     def _frame(self, now: float) -> None:
-        snap = replay_snapshot(self.session.snapshot())  # during a replay: the recorded step at the playhead
+        live = self.session.snapshot()
+        snap = replay_snapshot(live)  # during a replay: the recorded step at the playhead (settings: live's)
         if snap.settings.model != self.model_name:
-            self._rebuild_for_model(snap)
+            self._rebuild_for_model(live)
         seen = self._seen
         jumped = (snap.replay is not None or seen.replaying) and not 0.0 <= snap.t - seen.t < 0.5  # a replay seek
         seen.t, seen.replaying = snap.t, snap.replay is not None
@@ -165,7 +166,7 @@ class Renderer:
             self.connections.notify_by_id(notice.client, notice.title, notice.body, notice.level)
         if self.controls.apply_reverts() or snap.settings_version != seen.settings_version:
             seen.settings_version = snap.settings_version
-            self.sync_settings(snap)
+            self.sync_settings(live)
         if now >= seen.next_plot:
             seen.next_plot = now + PLOT_S
             self._update_plots(snap)

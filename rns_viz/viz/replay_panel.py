@@ -11,6 +11,7 @@ drawn from the recording (plays from any static file server, no Python), or the 
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 import traceback
@@ -178,7 +179,8 @@ class ReplayPanel:
         if replay is None:
             self._shown_version = -1
             return
-        t0, t1 = (round(x, 2) for x in replay.recording.span)
+        t0, t1 = replay.recording.span
+        t0, t1 = math.floor(100.0 * t0) / 100.0, math.ceil(100.0 * t1) / 100.0  # the slider's 0.01 s grid
         if (self.timeline.min, self.timeline.max) != (t0, t1):
             with self.controls.quiet():
                 self.timeline.min, self.timeline.max = t0, t1
