@@ -4,6 +4,7 @@ Run on demand (Debian chromium needed for the browser scenario):
 
     python benchmarks/bench_app.py                     # TREP, 60 s per scenario
     python benchmarks/bench_app.py --model planar3r --seconds 20
+    python benchmarks/bench_app.py --teach --seconds 70  # issue 11: teaching views and recording, vs off
 
 The app runs in its own process (its CPU time is measured there, with time.process_time over all
 its threads); clients run in this process. Scenarios, each with the shadow run on:
@@ -17,6 +18,13 @@ its threads); clients run in this process. Scenarios, each with the shadow run o
 Printed per scenario: real-time factor (target >= 0.99), scene update rate (frames sent, target
 >= 30 Hz) and as received by a client, plot update rate (target >= 10 Hz), server CPU as % of
 one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms).
+
+``--teach`` (issue 11) runs the one-browser scenario twice in the same run: first a baseline with
+every *Show in the scene* view off (no ghost, no arrows, trail or region) and the recorder switched
+off, then with all of them on and the recorder recording (as the app always does). Printed for both:
+the figures above and the server's resident memory; then the ring buffer's size for 60 s, the memory
+it added over the baseline, and the memory a 60 s replay takes (the immutable copy it replays).
+Use ``--seconds 60`` or more so the ring has filled once.
 """
 
 from __future__ import annotations
@@ -36,12 +44,31 @@ sys.path.insert(0, str(ROOT))  # tests/ holds the browser and websocket helpers
 
 
 # ---------------------------------------------------------------- server side (a child process)
-def serve(model: str) -> None:
-    """Start the app, print its handles as JSON, then answer 'stats' lines until 'quit'."""
+def rss_mb() -> float:
+    """This process's resident memory, MB (Linux /proc)."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def serve(model: str, teach: str | None = None) -> None:
+    """Start the app, print its handles as JSON, then answer 'stats' lines until 'quit'.
+    ``teach``: "on" shows every teaching view; "off" hides them all and switches the recorder off."""
     from rns_viz.viz.app import TARGET_HANDLE, start_app
+    from rns_viz.viz.view_toggles import TOGGLES
 
     out, sys.stdout = sys.stdout, sys.stderr  # viser prints a banner: keep the protocol pipe clean
+    if teach == "off":  # the baseline records nothing (its ring buffer is never even allocated)
+        from rns_viz.live.recorder import Recorder
+
+        Recorder.append = lambda *args: None  # type: ignore[method-assign]
     app = start_app(model, port=0, verbose=False)
+    recorder = app.session.state.outputs.recorder
+    if teach == "off":
+        app.view.show_only(())
+    elif teach == "on":
+        app.view.show_only([name for name, *_ in TOGGLES])
     g = app.gui
     info = {
         "port": app.port,
@@ -56,6 +83,9 @@ def serve(model: str) -> None:
         if line.strip() == "quit":
             break
         s = app.session
+        if line.strip() == "replay":  # the newest 60 s replayed: what the immutable copy costs
+            s.start_replay(60.0)
+            time.sleep(2.0)
         snap = s.snapshot()
         stats = {
             "wall": time.perf_counter(),
@@ -67,6 +97,9 @@ def serve(model: str) -> None:
             "latencies": s.latencies(),
             "ee": app.model.ee_position(snap.q[app.model.m :]).tolist(),
             "clients": len(app.server.get_clients()),
+            "rss_mb": rss_mb(),
+            "ring_mb": recorder.nbytes() / 1e6,
+            "recorded_s": len(recorder) * s.dt,
         }
         s._latencies.clear()
         print(json.dumps(stats), file=out, flush=True)
@@ -75,9 +108,9 @@ def serve(model: str) -> None:
 
 # ---------------------------------------------------------------- client side
 class Server:
-    def __init__(self, model: str) -> None:
+    def __init__(self, model: str, teach: str | None = None) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, __file__, "--serve", "--model", model],
+            [sys.executable, __file__, "--serve", "--model", model, *(["--teach-mode", teach] if teach else [])],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -92,9 +125,9 @@ class Server:
             raise RuntimeError("the app process ended early")
         return line
 
-    def stats(self) -> dict[str, Any]:
+    def stats(self, command: str = "stats") -> dict[str, Any]:
         assert self.proc.stdin is not None
-        self.proc.stdin.write("stats\n")
+        self.proc.stdin.write(f"{command}\n")
         self.proc.stdin.flush()
         return json.loads(self._line())
 
@@ -122,6 +155,7 @@ def summarize(name: str, a: dict[str, Any], b: dict[str, Any], client_rates: tup
         scene_rx, plots_rx = client_rates
         print(f"  received by a client  {scene_rx:6.1f} Hz scene windows, {plots_rx:5.1f} Hz plot updates")
     print(f"  server CPU            {cpu:6.1f} % of one core (target <= 60)")
+    print(f"  server memory         {b['rss_mb']:6.1f} MB resident; recorded {b['recorded_s']:.1f} s")
 
 
 def kicker(ws: Any, uuid: str, stop: threading.Event, every: float = 5.0) -> None:
@@ -129,15 +163,15 @@ def kicker(ws: Any, uuid: str, stop: threading.Event, every: float = 5.0) -> Non
         ws.click(uuid)
 
 
-def scenario_browser(model: str, seconds: float) -> None:
+def scenario_browser(model: str, seconds: float, teach: str | None = None) -> dict[str, Any] | None:
     from tests.browser import CHROMIUM, CHROMIUM_FLAGS, wait_until
 
     if not CHROMIUM.is_file():
         print(f"\n== one browser: skipped (no {CHROMIUM})")
-        return
+        return None
     from playwright.sync_api import sync_playwright
 
-    srv = Server(model)
+    srv = Server(model, teach)
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
@@ -153,10 +187,26 @@ def scenario_browser(model: str, seconds: float) -> None:
                 page.get_by_role("button", name="Kick the base").click()
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
             b = srv.stats()
+            if teach == "on":
+                b["replay_rss_mb"] = srv.stats("replay")["rss_mb"]
             browser.close()
-        summarize("one browser (Playwright chromium, software rendering)", a, b, None)
+        views = {None: "", "off": ", teaching views and recorder off", "on": ", ghost, all overlays and recorder on"}
+        summarize(f"one browser (Playwright chromium, software rendering{views[teach]})", a, b, None)
+        return b
     finally:
         srv.close()
+
+
+def scenario_teach(model: str, seconds: float) -> None:
+    """The browser scenario without and with the teaching views and the recorder (issue 11)."""
+    off = scenario_browser(model, seconds, "off")
+    on = scenario_browser(model, seconds, "on")
+    if off is None or on is None:
+        return
+    print("\n== recording (issue 11)")
+    print(f"  ring buffer for 60 s  {on['ring_mb']:6.1f} MB (target <= 50), holding {on['recorded_s']:.1f} s now")
+    print(f"  resident memory       {on['rss_mb'] - off['rss_mb']:+6.1f} MB over the baseline (views + recorder)")
+    print(f"  a 60 s replay         {on['replay_rss_mb'] - on['rss_mb']:+6.1f} MB more while it is shown")
 
 
 def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
@@ -229,12 +279,19 @@ def main() -> None:
     parser.add_argument("--model", default="trep", choices=("trep", "planar3r"))
     parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
     parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
+    parser.add_argument("--teach", action="store_true", help="issue 11: one browser, teaching views off then on")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--teach-mode", choices=("on", "off"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.serve:
-        serve(args.model)
+        serve(args.model, args.teach_mode)
         return
-    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario, 2 cores shared")
+    load = Path("/proc/loadavg").read_text().split()[:3]
+    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario; load {' '.join(load)}")
+    if args.teach:
+        scenario_teach(args.model, args.seconds)
+        print(f"\nload average after: {' '.join(Path('/proc/loadavg').read_text().split()[:3])}")
+        return
     if args.only in (None, "browser"):
         scenario_browser(args.model, args.seconds)
     if args.only in (None, "clients"):

@@ -1,15 +1,17 @@
 """Issue 11 in a real headless Chromium: a student walks lesson 1 (kick the base, watch it swing) with
 the ghost of the shadow run shown. Screenshots: artifacts/lesson1_start.png, lesson1_done.png and
 ghost_trep.png (the base deflection drawn x50: the arm swings, the ghost with suppression has settled),
-picture_trep.png, saved by the app's Save picture button, and playback_trep.png: an exported recording
-playing in viser's own client from a static file server.
+picture_trep.png, saved by the app's Save picture button, and playback_trep.png: the last seconds of a
+run exported as the player zip, playing in viser's own client from a static file server.
 """
 
 from __future__ import annotations
 
 import http.server
+import io
 import threading
 import time
+import zipfile
 from collections.abc import Iterator
 from functools import partial
 from pathlib import Path
@@ -20,7 +22,7 @@ from playwright.sync_api import sync_playwright
 
 from rns_viz.viz.app import RnsApp, start_app
 from rns_viz.viz.ghost import Ghost
-from rns_viz.viz.recording import PLAYER_URL, write_player_folder
+from rns_viz.viz.recording import PLAYER_URL, RECORDING_NAME
 from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.teach_scene import TeachScene
 from tests.browser import (
@@ -98,22 +100,25 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
 
 
 def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
-    """Record 1.5 s of a kicked TREP, export the player folder, serve it statically, open it in Chromium."""
+    """Export the last 1.5 s of a kicked TREP as the player zip (what the button downloads), unzip it,
+    serve it statically (no rns_viz, no viser server) and open it in Chromium: the arm, its base and the
+    ghost are there, and the base moves as the file plays."""
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         assert app.session.wait_background()
-        assert app.recorder.record(1.5, None)
         app.session.kick(0.8)
-        for _ in range(15):
-            app.session.advance(0.05)
-            time.sleep(0.1)
-        wait_until(lambda: app.recorder.last is not None, 30.0, "the recording")
-        data = app.recorder.last
+        app.session.advance(1.5)
+        recording = app.session.recording(1.5)
+        assert recording is not None
+        name, data = app.replay.export(recording, "player", app.session.snapshot(), 50.0)
     finally:
         app.stop()
-    assert data is not None
-    write_player_folder(data, tmp_path)
-    handler = partial(http.server.SimpleHTTPRequestHandler, directory=str(tmp_path))
+    assert name.endswith(".zip")
+    with zipfile.ZipFile(io.BytesIO(data)) as z:
+        z.extractall(tmp_path)
+    folder = tmp_path / "rns_scene_player"
+    assert (folder / "index.html").is_file() and (folder / RECORDING_NAME).is_file()
+    handler = partial(http.server.SimpleHTTPRequestHandler, directory=str(folder))
     httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
     threading.Thread(target=httpd.serve_forever, daemon=True).start()
     try:
@@ -123,6 +128,14 @@ def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
                 page = browser.new_page(viewport={"width": 1280, "height": 800})
                 page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}", timeout=60_000)
                 wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, FsmsScene.ROBOT}, timeout=60.0)
+                seen = set()
+                deadline = time.monotonic() + 20.0
+                while len(seen) < 3 and time.monotonic() < deadline:  # the base at several places as it plays
+                    pos = local_position(page, FsmsScene.BASE)
+                    if pos is not None:
+                        seen.add(round(pos[0], 5))
+                    time.sleep(0.1)
+                assert len(seen) >= 3, f"the base did not move in the player: {seen}"
                 wait_for_frames(page, 20)
                 assert screenshot(page, "playback_trep").stat().st_size > 10_000
             finally:

@@ -20,6 +20,7 @@ import numpy as np
 from rns_viz.control import Gains, InvalidGain, LawKind
 from rns_viz.live.lessons import LESSONS
 from rns_viz.live.pacing import SPEEDS
+from rns_viz.live.recorder import MAX_RECORD_S
 from rns_viz.params import MODEL_NAMES
 from rns_viz.scenarios import SCENARIOS
 
@@ -28,6 +29,7 @@ MAX_KICK_N = 1e4  # N: larger peaks are refused as input errors, not physics
 MAX_TARGET_M = 1e3  # m: a farther target is refused outright (it would mean nothing)
 MAX_UBAR_SPEED = 1e4  # 1/(kg m s)
 MAX_TARGET_SPEED = 100.0  # m/s
+REPLAY_SPEEDS = (0.1, 4.0)  # recorded seconds per wall second
 GAIN_NAMES = frozenset(f.name for f in fields(Gains))
 
 
@@ -231,6 +233,52 @@ class StartLesson(Command):
 @dataclass(frozen=True)
 class StopLesson(Command):
     pass
+
+
+@dataclass(frozen=True)
+class ReplayCommand(Command):
+    """The replay's inputs (:mod:`rns_viz.live.replay` applies them); any other input ends a replay first."""
+
+
+@dataclass(frozen=True)
+class StartReplay(ReplayCommand):
+    seconds: float  # s: replay the newest this many seconds of the run (the live simulation waits)
+
+    def __post_init__(self) -> None:
+        if not 0.0 < _finite("replay length", self.seconds) <= MAX_RECORD_S:
+            raise ValueError(f"replay length must be more than 0 and at most {MAX_RECORD_S:g} s, got {self.seconds}")
+
+
+@dataclass(frozen=True)
+class SeekReplay(ReplayCommand):
+    t: float  # s, simulation time within the recording (the loop checks it is inside)
+
+    def __post_init__(self) -> None:
+        if _finite("replay time", self.t) < 0.0:
+            raise ValueError(f"replay time must be a time of the recording (s, not negative), got {self.t}")
+
+
+@dataclass(frozen=True)
+class SetReplaySpeed(ReplayCommand):
+    speed: float  # recorded seconds per wall second
+
+    def __post_init__(self) -> None:
+        lo, hi = REPLAY_SPEEDS
+        if not lo <= _finite("replay speed", self.speed) <= hi:
+            raise ValueError(f"replay speed must be from {lo:g}x to {hi:g}x, got {self.speed}")
+
+
+@dataclass(frozen=True)
+class PlayReplay(ReplayCommand):
+    on: bool  # play (from the start again if at the end) or pause the replay
+
+    def __post_init__(self) -> None:
+        _switch("replay playing", self.on)
+
+
+@dataclass(frozen=True)
+class StopReplay(ReplayCommand):
+    pass  # back to live: the simulation resumes where it was (paused if it was paused)
 
 
 # Operator inputs whose arrival-to-first-step latency is measured.

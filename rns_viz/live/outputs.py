@@ -15,6 +15,7 @@ from rns_viz.control import ControlOutput
 from rns_viz.live.plots import PlotBuffers
 from rns_viz.live.reaction import ReactionProbe
 from rns_viz.live.readouts import compute_readouts
+from rns_viz.live.recorder import Recorder
 from rns_viz.live.records import Readouts
 from rns_viz.live.runs import RunPair
 from rns_viz.model import FsmsModel
@@ -38,6 +39,7 @@ def reference_point(model: FsmsModel, out: ControlOutput | None) -> np.ndarray |
 class Outputs:
     def __init__(self, plot_capacity: int = 500) -> None:
         self.plots = PlotBuffers(plot_capacity)
+        self.recorder = Recorder()  # the last minute of steps, for replay and export
         self.steps = 0  # steps booked since the session started (never reset: readers wait on it)
         self._probe: ReactionProbe | None = None
         self.restart(None)
@@ -45,6 +47,7 @@ class Outputs:
     def restart(self, model: FsmsModel | None, q: np.ndarray | None = None) -> None:
         """Forget history (reset, model switch, preset load)."""
         self.plots.clear()
+        self.recorder.restart()
         self.last: ControlOutput | None = None
         self.reaction = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1), first selected row
         self.reaction_t = math.nan  # s: the step it was evaluated at (its start time)
@@ -66,6 +69,7 @@ class Outputs:
             self._evaluate_reaction(runs, out)
         if (self.steps + 1) % REACTION_EVERY == 0:  # the next step is evaluated: keep its start state
             self._pre = (sim.t, np.concatenate((sim.q, sim.v)))
+        self.recorder.append(runs, shadow_on, self.reaction, suppress)
         if self.steps % PLOT_EVERY == 0:
             self._sample_plots(model, runs, out, shadow_on, suppress)
         if self.steps % READOUT_EVERY == 0:

@@ -13,6 +13,7 @@ import numpy as np
 
 from rns_viz.control import Gains, LawKind
 from rns_viz.defaults import defaults_for
+from rns_viz.live.recorder import Recording
 
 Level = Literal["info", "warning", "error"]
 UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)
@@ -80,6 +81,27 @@ class LessonStatus:
 
 
 @dataclass(frozen=True)
+class ReplayView:
+    """A replay in progress: the recording and its playhead. The playhead moves with the wall clock
+    while playing, so readers compute it (:meth:`position`) and the paused loop need not publish it."""
+
+    recording: Recording
+    start: float  # s (simulation time of the recording): the playhead at ``wall``
+    wall: float  # time.perf_counter() when the playhead was at ``start``
+    speed: float  # recorded seconds per wall second
+    playing: bool
+    version: int  # bumps at every replay command (a seek restarts the drawn trail)
+    was_paused: bool  # the live simulation was paused before the replay (back to live keeps it so)
+
+    def position(self, now: float) -> float:
+        """The playhead at wall time ``now`` (s, simulation time of the recording); it stops at the end."""
+        t0, t1 = self.recording.span
+        if not self.playing:
+            return self.start
+        return min(max(self.start + self.speed * (now - self.wall), t0), t1)
+
+
+@dataclass(frozen=True)
 class Snapshot:
     """The loop's state for renderers; a new object each time (never mutated)."""
 
@@ -102,6 +124,7 @@ class Snapshot:
     readouts: Readouts = field(default_factory=Readouts)
     overlay_version: int = 0
     lesson: LessonStatus | None = None
+    replay: ReplayView | None = None  # a replay is shown instead of the (paused) live simulation
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ from rns_viz.live import commands as c
 from rns_viz.live.gain_explorer import GainView
 from rns_viz.live.pacing import MAX_BACKLOG_S, SPEEDS, Pacer
 from rns_viz.live.plots import PlotBuffers
+from rns_viz.live.recorder import Recording
 from rns_viz.live.records import Notice, Overlays, Snapshot
 from rns_viz.live.state import LiveState
 from rns_viz.params import MODEL_NAMES
@@ -103,6 +104,15 @@ class Session:
         fmt = ",".join(["%.10g"] * len(columns))
         lines.extend(fmt % tuple(row) for row in rows)
         return ("\n".join(lines) + "\n").encode()
+
+    def recording(self, seconds: float) -> Recording | None:
+        """The newest ``seconds`` (at most 60) of the run as an immutable recording (None: nothing yet).
+        During a replay: the recording being replayed (what the viewer sees is what is exported)."""
+        replay = self._snapshot.replay
+        if replay is not None:
+            return replay.recording
+        with self._lock:
+            return self.state.outputs.recorder.take(seconds, self.state.model)
 
     def stop(self) -> None:
         self._stop = True
@@ -192,6 +202,25 @@ class Session:
 
     def stop_lesson(self, client: int | None = None) -> None:
         self.send(c.StopLesson(client=client))
+
+    def start_replay(self, seconds: float, client: int | None = None) -> None:
+        """Replay the newest ``seconds`` (at most 60) of the run; the simulation waits until back to live."""
+        self.send(c.StartReplay(seconds, client=client))
+
+    def seek_replay(self, t: float, client: int | None = None) -> None:
+        """Move the replay's playhead to simulation time ``t`` (s) of the recording."""
+        self.send(c.SeekReplay(t, client=client))
+
+    def set_replay_speed(self, speed: float, client: int | None = None) -> None:
+        """Replay at ``speed`` recorded seconds per wall second (0.1 to 4)."""
+        self.send(c.SetReplaySpeed(speed, client=client))
+
+    def play_replay(self, on: bool, client: int | None = None) -> None:
+        self.send(c.PlayReplay(on, client=client))
+
+    def stop_replay(self, client: int | None = None) -> None:
+        """Back to live: the simulation goes on where it was (paused if it was paused)."""
+        self.send(c.StopReplay(client=client))
 
     # ================================================================ manual driving (realtime=False)
     def advance(self, seconds: float) -> None:

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 from rns_viz.live.operator import Operator
 from rns_viz.live.outputs import Outputs
-from rns_viz.live.records import LessonStatus, Settings, Snapshot
+from rns_viz.live.records import LessonStatus, ReplayView, Settings, Snapshot
 from rns_viz.live.runs import RunPair
 
 
@@ -18,6 +18,7 @@ def make_snapshot(
     out: Outputs,
     flags: tuple[bool, str | None, float, bool],
     lesson: LessonStatus | None,
+    replay: ReplayView | None = None,
 ) -> Snapshot:
     """The loop's state for readers, a new immutable record each time. ``versions`` = (epoch, settings,
     target, overlay) versions; ``flags`` = (paused, why it diverged or None, real-time factor, behind)."""
@@ -50,4 +51,5 @@ def make_snapshot(
         readouts=readouts,
         overlay_version=overlay_version,
         lesson=lesson,
+        replay=replay,
     )

@@ -1,10 +1,6 @@
-"""The state of a live session, owned by its simulation loop: one object, touched by one thread.
-
-:class:`LiveState` holds the settings, the run pair, the operator, the background jobs and the
-outputs. The loop calls :meth:`LiveState.apply` for each queued command (a ``match`` on its type),
-:meth:`LiveState.tick` for each step and :meth:`LiveState.collect` for finished background results;
-:meth:`LiveState.publish` makes the immutable snapshot readers take. Nothing here imports viser.
-"""
+"""The state of a live session, owned by its simulation loop: one object, touched by one thread. The loop
+calls :meth:`LiveState.apply` per command (a ``match``; replay's in live/replay.py), :meth:`tick` per step,
+:meth:`collect` for background results; :meth:`publish` makes the snapshot readers take. No viser here."""
 
 from __future__ import annotations
 
@@ -28,7 +24,8 @@ from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
 from rns_viz.live.path_table import PathTable
 from rns_viz.live.readouts import arm_reach
-from rns_viz.live.records import Level, Notice, Settings, Snapshot
+from rns_viz.live.records import Level, Notice, ReplayView, Settings, Snapshot
+from rns_viz.live.replay import apply_replay
 from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
@@ -50,6 +47,7 @@ class LiveState:
         self.epoch = self.settings_version = self.target_version = 0
         self.paused = False
         self.diverged: str | None = None
+        self.replay: ReplayView | None = None  # a replay shown while the simulation waits (live/replay.py)
         self.settings = Settings.defaults(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
         self.lesson: LessonRun | None = None
@@ -173,7 +171,8 @@ class LiveState:
         """Apply one command; InputRefused/ValueError leave everything as it was and tell the sender. A path
         motion asked for while the path is being computed waits for it (the latest wins) and runs then."""
         try:
-            self._apply(cmd)
+            if not apply_replay(self, cmd):  # replay commands; any other input ends a replay first
+                self._apply(cmd)
         except PathNotReady:
             self._waiting_for_path = cmd
             self.notify("Waiting for the path", "It starts as soon as the reactionless path is computed.", cmd.client)
@@ -397,4 +396,5 @@ class LiveState:
         lesson = self.lesson.status() if self.lesson is not None else None
         rtf = 0.0 if self.paused else self.pacer.rtf() if realtime else math.nan
         flags = (self.paused, self.diverged, rtf, realtime and not self.paused and self.pacer.behind())
-        return make_snapshot(self.settings, versions, self.runs, self.operator, self.outputs, flags, lesson)
+        out = (self.runs, self.operator, self.outputs)
+        return make_snapshot(self.settings, versions, *out, flags, lesson, self.replay)

@@ -112,6 +112,10 @@ class StepLog:
         self._incomplete += 1
         return row
 
+    def newest(self) -> np.ndarray | None:
+        """The newest row as a view (derived columns not yet filled), or None if the log is empty."""
+        return self._data[self._next - 1] if self._count else None
+
     def clear(self) -> None:
         self._next = 0
         self._count = 0
@@ -159,6 +163,11 @@ class StepLog:
             self._write(target, rows)
 
     def _write(self, handle: object, rows: np.ndarray) -> None:
-        writer = csv.writer(handle)  # type: ignore[arg-type]
-        writer.writerow(self.columns)
-        writer.writerows([[f"{x:.10g}" for x in row] for row in rows])
+        write_csv_rows(handle, self.columns, rows)
+
+
+def write_csv_rows(handle: object, header: list[str], rows: np.ndarray, digits: int = 10) -> None:
+    """A header line and one line per row, ``digits`` significant digits (17 reads back bit-exact)."""
+    writer = csv.writer(handle)  # type: ignore[arg-type]
+    writer.writerow(header)
+    writer.writerows([[f"{x:.{digits}g}" for x in row] for row in rows])

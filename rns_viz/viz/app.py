@@ -27,8 +27,8 @@ from rns_viz.viz.inputs import Controls
 from rns_viz.viz.lesson_panel import LessonPanel
 from rns_viz.viz.path_words import PathWords
 from rns_viz.viz.pictures import Pictures
-from rns_viz.viz.recording import SceneRecorder
 from rns_viz.viz.render import TARGET_HANDLE, Renderer
+from rns_viz.viz.replay_panel import ReplayPanel
 from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.view_toggles import make_view_toggles
 
@@ -51,7 +51,8 @@ class RnsApp:
         self.path_words = PathWords(server, self.gui.path_folder, order=self.gui.sigma.order + 0.01)
         self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
         self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
-        self.recorder = SceneRecorder(server, self.connections)
+        self.replay = ReplayPanel(server, session, self.controls, self.connections, self.view)
+        self.renderer.text_panels.append(self.replay.refresh)
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 

@@ -143,9 +143,8 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             "Reset", icon=viser.Icon.REFRESH, hint="Back to the start (of the preset, if one is loaded)."
         )
     with gui.add_folder("Paper presets"):
-        hint = "One click loads an experiment's law, gains, motion and kicks (and its model)."
-        presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=hint)
-        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=hint)
+        presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=preset_hint(TREP_PRESETS))
+        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=preset_hint(PLANAR3R_PRESETS))
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
@@ -292,6 +291,13 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         shadow=shadow,
         download=download,
     )
+
+
+def preset_hint(names: tuple[str, ...]) -> str:
+    """One click loads a figure's experiment; what each button is, in the paper's figure order."""
+    what = "; ".join(f"{name}: {SCENARIOS[name].description.split(': ', 1)[-1]}" for name in names)
+    units = "Gains in 1/s, u-bar in 1/(kg m s)."
+    return f"One click loads a figure's experiment (law, gains, motion, kicks, model). {what}. {units}"
 
 
 def preset_description(name: str | None) -> str:

@@ -65,6 +65,10 @@ def _chart(
 
 
 ON_OFF = (("suppression on", ON_COLOUR), ("suppression off", OFF_COLOUR))
+PLOTS_CAPTION = (
+    '<div style="font-size:0.75em;opacity:0.8">The last 10 s: how far the base is bent, x_b (µm); the momentum '
+    "the arm's joints hand to the base, L (mN·s = g·m/s); how far the hand is from where it is sent, |e| (mm).</div>"
+)
 
 
 class LivePlots:
@@ -72,6 +76,7 @@ class LivePlots:
 
     def __init__(self, gui: viser.GuiApi) -> None:
         linear: viser.uplot.Scale = {"auto": True}
+        self.caption = gui.add_html(PLOTS_CAPTION)  # charts take no hint: their meaning in plain words
         self.charts: dict[str, dict[str, viser.GuiUplotHandle]] = {}
         for mode in SCALES:
             xb_scale, L_scale = linear, linear
@@ -139,6 +144,11 @@ def _clean(x: np.ndarray) -> np.ndarray:
 
 
 _ROWS = (("xb", "|x_b|", "m"), ("L", "|L|", "N·s"), ("e", "|e|", "m"))
+_ROW_HINTS = {
+    "xb": "largest bend of the base from rest in the last 10 s",
+    "L": "largest momentum the joints handed to the base (1 N·s = 1 kg·m/s)",
+    "e": "largest distance of the hand from where the law sends it",
+}
 
 
 def peaks_html(peaks: dict[str, tuple[float, float]] | None) -> str:
@@ -154,7 +164,7 @@ def peaks_html(peaks: dict[str, tuple[float, float]] | None) -> str:
             f'<td data-peak="{key}-{side}" data-si="{v!r}" style="text-align:right">{html.escape(si(v, unit))}</td>'
             for side, v in (("on", on), ("off", off))
         )
-        rows.append(f"<tr><td>{html.escape(label)}</td>{cells}</tr>")
+        rows.append(f'<tr title="{_ROW_HINTS[key]}"><td>{html.escape(label)}</td>{cells}</tr>')
     note = "|e|: the operated run. Blue is always suppression on, red off; the other run is the shadow run."
     return (
         '<table style="font-size:0.8em;width:100%">' + head + "".join(rows) + "</table>"

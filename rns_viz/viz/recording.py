@@ -1,89 +1,84 @@
-"""Record the scene for viser's own player: a button records the next N seconds of the scene (the
-arm, the ghost, every overlay, as the browsers see them) with viser's scene serializer and hands the
-clicking browser a zip of a folder: viser's built client and the ``.viser`` file. Served by any static
-file server it plays (``index.html?playbackPath=rns_scene.viser``) with no Python running: a demo
-prepared once, played in class.
+"""A recording as a folder that plays in viser's own client with no Python running.
 
-Timing: a small thread inserts the wall-clock time between frames (30 Hz) while recording, so the
-file plays at the speed it was seen.
+:func:`scene_file` draws an immutable recording of the live session (:mod:`rns_viz.live.recorder`)
+frame by frame into a private, unconnected viser server's scene (the same arm, base, ghost and
+teaching arrows as the app) while viser's scene serializer records every message with the recorded
+time between frames; :func:`player_zip` packs viser's built client (one ``index.html``) and the
+``.viser`` file. Served by any static file server it plays (``index.html?playbackPath=rns_scene.viser``,
+with viser's own timeline, pause and speed): a demo prepared once, played in class without risk.
 """
 
 from __future__ import annotations
 
 import io
-import threading
-import time
-import traceback
 import zipfile
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import viser
 
-from rns_viz.viz.connections import Connections
+from rns_viz.live.recorder import Recording
+from rns_viz.live.records import Overlays, ReplayView, Snapshot
+from rns_viz.live.replay import replay_snapshot
+from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.teach_scene import TeachScene
+from rns_viz.viz.view_toggles import ViewToggles
 
 RECORDING_NAME = "rns_scene.viser"
 PLAYER_URL = f"index.html?playbackPath={RECORDING_NAME}"  # open this from a static server of the folder
-TICK_S = 1.0 / 30.0  # s between inserted sleeps (the player's time resolution)
-MAX_SECONDS = 60.0
+FRAME_S = 1.0 / 30.0  # s of recorded time between drawn frames (the player's time resolution)
+REACTION_LABEL = "arm reaction"
 
 
-class SceneRecorder:
-    """The *Record for playback* slider and button; one recording at a time."""
+def scene_file(
+    recording: Recording,
+    template: Snapshot,
+    overlays: Overlays | None = None,
+    exaggeration: float = 1.0,
+    view: ViewToggles | None = None,
+) -> bytes:
+    """The recording drawn at 30 frames per recorded second as a ``.viser`` file (bytes).
 
-    def __init__(self, server: viser.ViserServer, connections: Connections) -> None:
-        self.server, self.connections = server, connections
-        self.last: bytes | None = None  # the last finished recording (tests read it)
-        self._busy = threading.Lock()
-        with server.gui.add_folder("Record for playback", expand_by_default=False):
-            self.seconds = server.gui.add_slider(
-                "Length (s)",
-                min=1.0,
-                max=MAX_SECONDS,
-                step=1.0,
-                initial_value=10.0,
-                hint="How many seconds of the scene to record, from the click on.",
-            )
-            self.button = server.gui.add_button(
-                "Record the scene (.viser)",
-                icon=viser.Icon.PLAYER_RECORD,
-                hint="Records the scene as you see it and downloads a zip: a folder with viser's player and the "
-                f"recording; serve it with any static web server and open {PLAYER_URL}. No Python needed.",
-            )
-        self.button.on_click(self._on_click)
+    ``template``: a snapshot of the session (settings and readouts not recorded per step);
+    ``overlays``: the reactionless paths or reachable set to draw; ``view``: what is shown (all if None).
+    """
+    view = view or ViewToggles({})
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        scene = FsmsScene(server, recording.model, trail_frame="base")
+        teach = TeachScene(server, recording.model, scene)
+        teach.reaction_label = REACTION_LABEL
+        if overlays is not None:
+            _draw_overlays(scene, teach, overlays)
+        serializer = server.get_scene_serializer()
+        t0, t1 = recording.span
+        m = recording.model.m
+        for k, t in enumerate(np.arange(t0, t1 + 0.5 * recording.dt, FRAME_S)):
+            if k:
+                serializer.insert_sleep(FRAME_S)
+            frame = replace(template, replay=ReplayView(recording, float(t), 0.0, 1.0, False, 0, True))
+            snap = replay_snapshot(frame)
+            q = snap.q.copy()
+            q[:m] = np.clip(q[:m], -10.0 / max(exaggeration, 1e-9), 10.0 / max(exaggeration, 1e-9))
+            with server.atomic():
+                scene.update(q, exaggeration)
+                scene.set_reaction_force(float(np.nan_to_num(snap.readouts.reaction)), REACTION_LABEL)
+                teach.draw(snap, snap.q_shadow, exaggeration, view)
+        return serializer.serialize()
+    finally:
+        server.stop()
 
-    def _on_click(self, event: viser.GuiEvent) -> None:
-        value = self.seconds.value
-        seconds = float(value) if isinstance(value, int | float) else 10.0
-        if not 0.0 < seconds <= MAX_SECONDS:  # a hostile value: the default
-            seconds = 10.0
-        if not self.record(seconds, event.client):
-            self.connections.notify(event.client, "Already recording", "One recording at a time.", "warning")
 
-    def record(self, seconds: float, client: viser.ClientHandle | None) -> bool:
-        """Start recording ``seconds`` of the scene in the background; False if one is running."""
-        if not self._busy.acquire(blocking=False):
-            return False
-        threading.Thread(target=self._run, args=(seconds, client), name="rns-record", daemon=True).start()
-        return True
-
-    def _run(self, seconds: float, client: viser.ClientHandle | None) -> None:
-        try:
-            serializer = self.server.get_scene_serializer()
-            start = last = time.perf_counter()
-            while last - start < seconds:
-                time.sleep(TICK_S)
-                now = time.perf_counter()
-                serializer.insert_sleep(now - last)
-                last = now
-            data = serializer.serialize()
-            self.last = data
-            if client is not None:
-                client.send_file_download("rns_scene_player.zip", player_zip(data), save_immediately=True)
-        except Exception as exc:  # a recording must never take the server down
-            traceback.print_exc()
-            self.connections.notify(client, "Recording failed", f"{type(exc).__name__}: {exc}", "error")
-        finally:
-            self._busy.release()
+def _draw_overlays(scene: FsmsScene, teach: TeachScene, overlays: Overlays) -> None:
+    curves = list(overlays.family or [])
+    if overlays.current is not None:
+        curves.append(overlays.current)
+    if curves:
+        scene.set_path_family(curves, len(curves) - 1 if overlays.current is not None else None)
+    scene.set_reachable_set(overlays.reach)
+    teach.set_reach(overlays.reach)
+    teach.set_path(overlays.current)
 
 
 def player_files(data: bytes) -> dict[str, bytes]:

@@ -19,6 +19,7 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Snapshot
+from rns_viz.live.replay import replay_snapshot
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
 from rns_viz.viz.connections import Connections
@@ -140,11 +141,14 @@ class Renderer:
             self._stop.wait(max(0.0, delay))
 
     def _frame(self, now: float) -> None:
-        snap = self.session.snapshot()
+        live = self.session.snapshot()
+        snap = replay_snapshot(live)  # during a replay: the recorded step at the playhead (settings: live's)
         if snap.settings.model != self.model_name:
-            self._rebuild_for_model(snap)
+            self._rebuild_for_model(live)
         seen = self._seen
-        if snap.epoch != seen.epoch:
+        jumped = (snap.replay is not None or seen.replaying) and not 0.0 <= snap.t - seen.t < 0.5  # a replay seek
+        seen.t, seen.replaying = snap.t, snap.replay is not None
+        if snap.epoch != seen.epoch or jumped:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
         self._draw_state(snap)
@@ -162,7 +166,7 @@ class Renderer:
             self.connections.notify_by_id(notice.client, notice.title, notice.body, notice.level)
         if self.controls.apply_reverts() or snap.settings_version != seen.settings_version:
             seen.settings_version = snap.settings_version
-            self.sync_settings(snap)
+            self.sync_settings(live)
         if now >= seen.next_plot:
             seen.next_plot = now + PLOT_S
             self._update_plots(snap)
@@ -226,13 +230,15 @@ class Renderer:
 
     # ---------------------------------------------------------------- the panel
     def _update_plots(self, snap: Snapshot) -> None:
-        version = self.session.plots.version
+        replay = snap.replay  # during a replay: the recording's plots up to the playhead
+        version = self.session.plots.version if replay is None else (replay.version, snap.t)
         if self.gui.plots.mode != self._seen.plot_mode:  # the other scale's charts: send them data now
             self._seen.plot_mode = self.gui.plots.mode
         elif version == self._seen.plot_version:
             return
         self._seen.plot_version = version
-        if self.gui.plots.update(self.session.plot_arrays()):
+        arrays = self.session.plot_arrays() if replay is None else replay.recording.plot_arrays(snap.t)
+        if self.gui.plots.update(arrays):
             self.plot_updates += 1
 
     def _update_text(self, snap: Snapshot) -> None:
@@ -320,7 +326,9 @@ class _Seen:
         self.target_version = -1
         self.target: tuple[float, ...] | None = ()
         self.settings_version = -1
-        self.plot_version = -1
+        self.plot_version: object = -1
+        self.t = 0.0  # s, the drawn state's time, and whether it was a replay's (a jump restarts the trail)
+        self.replaying = False
         self.next_plot = 0.0
         self.next_text = 0.0
         self.plot_mode = ""

@@ -1,0 +1,284 @@
+"""Always-on recording of the last minute of a live session, and the immutable recordings taken from it.
+
+:class:`Recorder` is fed by the simulation loop after every 1 ms step (through
+:class:`~rns_viz.live.outputs.Outputs`) and keeps the newest :data:`MAX_RECORD_S` seconds in one
+preallocated ring buffer: per step, the operated run's step-log row (t, x_b, x_b', θ, θ', τ, the
+base force, L, the distances to singularity and the law's references θ_ref / x_ref, exactly the
+floats of the simulation log), the shadow run's state, L and τ at the same t, the arm's reaction on
+the base (Eq. 1) as the readout showed it and whether suppression was on. Always on because it costs
+one row copy per step (a few µs, under 1 % of the loop) and 60 s of TREP fill 16 MB (3R: 19 MB);
+it restarts with the run (reset, model switch, preset load), so a recording never spans two systems.
+
+:meth:`Recorder.take` copies the newest N seconds into a :class:`Recording`: read-only arrays that any
+thread may replay, plot or export (CSV with units in the header, reading back bit-exact).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from rns_viz.live.plots import PLOT_SERIES
+from rns_viz.live.runs import RunPair
+from rns_viz.model import FsmsModel
+from rns_viz.sim.log import write_csv_rows
+
+MAX_RECORD_S = 60.0  # s of simulated time kept
+PLOT_WINDOW_S = 10.0  # s: the live plots' window, replayed alike
+PLOT_EVERY = 20  # steps between replayed plot samples (50 Hz, as live)
+EXTRA = ("reaction", "suppress")  # N: the readout's reaction; 1.0 while the operated run had suppression on
+_UNITS = {
+    "t": "s",
+    "xbdot": "m/s",
+    "xb": "m",
+    "thetadot": "rad/s",
+    "theta_ref": "rad",
+    "theta": "rad",
+    "tau": "N m",
+    "fext": "N",
+    "ee": "m",
+    "L": "kg m/s",
+    "sigma_hbm": "kg m",
+    "sigma_jbar": "m/rad",
+    "reaction": "N",
+    "suppress": "1 = on",
+}
+_SHADOW = ("xb", "xbdot", "theta", "thetadot", "L", "tau")  # the shadow run's columns kept (prefixes)
+
+
+def column_unit(name: str, rotational_base: bool = False) -> str:
+    """The unit of a recording or step-log column (``shadow_`` columns like their run's)."""
+    name = name.removeprefix("shadow_")
+    for prefix, unit in _UNITS.items():  # longest prefixes first where they share a start
+        if name == prefix or name.startswith(prefix + "_"):
+            if rotational_base and prefix in ("xb", "xbdot", "fext"):
+                return {"xb": "rad", "xbdot": "rad/s", "fext": "N m"}[prefix]
+            return unit
+    return ""
+
+
+def split_header(cell: str) -> str:
+    """``"xb_1 (m)"`` -> ``"xb_1"``."""
+    return cell.split(" (", 1)[0].strip()
+
+
+@dataclass(frozen=True, eq=False)
+class Recording:
+    """Steps of one run, oldest first: ``data[k]`` is the state at ``t[k]`` and what happened over the
+    step from there. Read-only; ``model`` is the loop's model instance (kinematics only, own data)."""
+
+    columns: tuple[str, ...]
+    data: np.ndarray  # (steps, columns), float64, read-only
+    model: FsmsModel = field(repr=False)
+    dt: float  # s
+    index: dict[str, int] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.data.setflags(write=False)
+        object.__setattr__(self, "index", {name: i for i, name in enumerate(self.columns)})
+
+    def __len__(self) -> int:
+        return len(self.data)
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.data[:, 0]
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """First and last recorded time, s (simulation time)."""
+        return float(self.data[0, 0]), float(self.data[-1, 0])
+
+    def columns_of(self, prefix: str) -> np.ndarray:
+        """Column indices ``prefix_1 .. prefix_k``."""
+        k = 1
+        out = []
+        while f"{prefix}_{k}" in self.index:
+            out.append(self.index[f"{prefix}_{k}"])
+            k += 1
+        return np.array(out, dtype=int)
+
+    def at(self, t: float) -> int:
+        """The newest step at or before time ``t`` (clamped to the recording)."""
+        return int(np.clip(np.searchsorted(self.t, t + 0.5 * self.dt, side="right") - 1, 0, len(self) - 1))
+
+    def q(self, k: int) -> np.ndarray:
+        """(x_b, θ) of the operated run at step k."""
+        return self.data[k, self._q]
+
+    def v(self, k: int) -> np.ndarray:
+        return self.data[k, self._v]
+
+    def q_shadow(self, k: int) -> np.ndarray | None:
+        """(x_b, θ) of the shadow run at step k; None where it was not running."""
+        q = self.data[k, self._q_shadow]
+        return q if np.all(np.isfinite(q)) else None
+
+    def value(self, k: int, name: str) -> float:
+        return float(self.data[k, self.index[name]])
+
+    @cached_property
+    def _q(self) -> np.ndarray:
+        return np.concatenate((self.columns_of("xb"), self.columns_of("theta")))
+
+    @cached_property
+    def _v(self) -> np.ndarray:
+        return np.concatenate((self.columns_of("xbdot"), self.columns_of("thetadot")))
+
+    @cached_property
+    def _q_shadow(self) -> np.ndarray:
+        return np.concatenate((self.columns_of("shadow_xb"), self.columns_of("shadow_theta")))
+
+    # ---------------------------------------------------------------- derived
+    def _ee(self, rows: np.ndarray, prefix: str) -> np.ndarray:
+        """End-effector positions (K, 3) of the given rows' joint angles (``theta`` or ``theta_ref``), m."""
+        thetas = self.data[np.ix_(rows, self.columns_of(prefix))]
+        out = np.full((len(rows), 3), np.nan)
+        ok = np.all(np.isfinite(thetas), axis=1)
+        if np.any(ok):
+            out[ok] = self.model.ee_positions(thetas[ok], self._pin_data)
+        return out
+
+    @cached_property
+    def _pin_data(self) -> object:
+        return self.model.pin_model.createData()  # never the loop's or the laws' data
+
+    @cached_property
+    def table(self) -> np.ndarray:
+        """All rows with the end-effector columns filled from θ, as the step log fills them on reading."""
+        out = self.data.copy()
+        if "ee_x" in self.index:
+            ee = self.index["ee_x"]
+            out[:, ee : ee + 3] = self._ee(np.arange(len(self)), "theta")
+        out.setflags(write=False)
+        return out
+
+    @cached_property
+    def _plot_rows(self) -> dict[str, np.ndarray]:
+        """The live plots' series (PLOT_SERIES; x_b in mm, L in kg m/s, error in mm) every PLOT_EVERY steps."""
+        rows = np.arange(0, len(self), PLOT_EVERY)
+        d, i = self.data, self.index
+        x = self._ee(rows, "theta")[:, :2]
+        ref = self._ee(rows, "theta_ref")[:, :2]
+        for a, col in enumerate(("ee_ref_x", "ee_ref_y")):
+            if col in i:
+                own = d[rows, i[col]]
+                ref[:, a] = np.where(np.isfinite(own), own, ref[:, a])
+        shadow_xb = d[rows, i["shadow_xb_1"]] * 1e3
+        return {
+            "t": d[rows, 0],
+            "xb": d[rows, i["xb_1"]] * 1e3,
+            "xb_shadow": shadow_xb,
+            "L": d[rows, i["L_1"]],
+            "L_shadow": d[rows, i["shadow_L_1"]],
+            "ee_error": np.linalg.norm(ref - x, axis=1) * 1e3,
+            "suppress": d[rows, i["suppress"]],
+        }
+
+    def plot_arrays(self, t: float) -> dict[str, np.ndarray]:
+        """The plots as they looked at time ``t``: the last PLOT_WINDOW_S seconds up to t (copies)."""
+        rows = self._plot_rows
+        lo, hi = np.searchsorted(rows["t"], (t - PLOT_WINDOW_S, t + 0.5 * self.dt), side="right")
+        return {name: rows[name][lo:hi].copy() for name in PLOT_SERIES}
+
+    def ee_error(self, k: int) -> float:
+        """|x_ref − x_e| at step k, m (NaN without a reference)."""
+        x = self._ee(np.array([k]), "theta")[0, :2]
+        ref = self._ee(np.array([k]), "theta_ref")[0, :2]
+        for a, col in enumerate(("ee_ref_x", "ee_ref_y")):
+            if col in self.index and math.isfinite(self.data[k, self.index[col]]):
+                ref[a] = self.data[k, self.index[col]]
+        return float(np.linalg.norm(ref - x))
+
+    # ---------------------------------------------------------------- CSV
+    def header(self) -> list[str]:
+        rotational = not self.model.base_is_translational
+        return [f"{name} ({column_unit(name, rotational)})" for name in self.columns]
+
+    def csv(self) -> bytes:
+        """Every step as CSV: a header with units, 17 significant digits (reads back bit-exact)."""
+        with io.StringIO(newline="") as text:
+            write_csv_rows(text, self.header(), self.table, digits=17)
+            return text.getvalue().encode()
+
+
+def read_csv(data: bytes) -> tuple[list[str], np.ndarray]:
+    """Column names (units stripped) and rows of a recording's or step log's CSV."""
+    reader = csv.reader(io.StringIO(data.decode()))
+    header = [split_header(cell) for cell in next(reader)]
+    rows = np.array([[float(x) for x in row] for row in reader if row], dtype=float)
+    return header, rows.reshape(-1, len(header))
+
+
+class Recorder:
+    """The ring buffer of the newest MAX_RECORD_S seconds of steps; only the loop thread writes it."""
+
+    def __init__(self, seconds: float = MAX_RECORD_S) -> None:
+        self.seconds = seconds
+        self._data: np.ndarray | None = None
+        self.columns: tuple[str, ...] = ()
+        self.restart()
+
+    def restart(self) -> None:
+        """Forget the steps (a new run); the buffer is kept for a run of the same shape."""
+        self._next = self._count = 0
+        self._configured = False
+
+    def _configure(self, runs: RunPair) -> None:
+        log = runs.sim.log
+        # The shadow's columns kept: two contiguous runs of its log row (state and torque; L), cheap to copy.
+        i = log.index
+        n, r = runs.model.n, len(runs.model.selected)
+        self._shadow_blocks = (slice(1, i["tau_1"] + n), slice(i["L_1"], i["L_1"] + r))
+        shadow_names = [c for block in self._shadow_blocks for c in log.columns[block]]
+        assert all(c.rsplit("_", 1)[0] in _SHADOW for c in shadow_names)
+        columns = (*log.columns, *(f"shadow_{c}" for c in shadow_names), *EXTRA)
+        self._log_width = w = len(log.columns)
+        self._shadow_into = (slice(w, w + i["tau_1"] + n - 1), slice(w + i["tau_1"] + n - 1, len(columns) - len(EXTRA)))
+        capacity = round(self.seconds / runs.sim.dt)
+        if self._data is None or columns != self.columns or len(self._data) != capacity:
+            self._data = np.full((capacity, len(columns)), np.nan)
+        self.columns, self.dt, self._configured = columns, runs.sim.dt, True
+
+    def nbytes(self) -> int:
+        """Memory held by the buffer, bytes."""
+        return 0 if self._data is None else self._data.nbytes
+
+    def __len__(self) -> int:
+        return self._count
+
+    def append(self, runs: RunPair, shadow_on: bool, reaction: float, suppress: bool) -> None:
+        """Book the step just taken: the newest log rows of both runs (state at the step's start t)."""
+        row_log = runs.sim.log.newest()
+        if row_log is None:
+            return
+        if not self._configured:
+            self._configure(runs)
+        data = self._data
+        assert data is not None
+        row = data[self._next]
+        row[: self._log_width] = row_log
+        (state, coupling), (state_to, coupling_to) = self._shadow_blocks, self._shadow_into
+        shadow = runs.shadow.log.newest() if shadow_on else None
+        if shadow is not None and shadow[0] == row_log[0]:
+            row[state_to] = shadow[state]
+            row[coupling_to] = shadow[coupling]
+        else:
+            row[state_to.start : coupling_to.stop] = np.nan
+        row[-2] = reaction
+        row[-1] = 1.0 if suppress else 0.0
+        self._next = (self._next + 1) % len(data)
+        self._count = min(self._count + 1, len(data))
+
+    def take(self, seconds: float, model: FsmsModel) -> Recording | None:
+        """The newest ``seconds`` of steps as an immutable :class:`Recording` (None if under two steps)."""
+        if self._data is None or self._count < 2:
+            return None
+        k = min(self._count, max(2, round(seconds / self.dt)))
+        rows = self._data[(self._next - k + np.arange(k)) % len(self._data)]  # a copy
+        return Recording(self.columns, rows, model, self.dt)
