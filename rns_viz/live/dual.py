@@ -158,20 +158,22 @@ def compensator_sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray,
 def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarray, warn_sigma: float) -> str | None:
     """Why the compensator cannot cancel the task arm's reaction now, or None when it does.
 
-    Near its singularity: sigma_min(S H_bm,2) below ``warn_sigma`` (kg m) while the residual coupling
-    momentum exceeds CANCEL_RATIO of the task arm's. Beyond its speed: a compensator joint faster than
-    the rated speed of the model's defaults (rad/s).
+    Near its singularity: sigma_min(S H_bm,2) below ``warn_sigma`` (kg m), where the damped inverse of
+    (9)-(10) gives up cancelling. Lagging: the residual coupling momentum exceeds CANCEL_RATIO of the
+    task arm's. Beyond its speed: a compensator joint faster than its rated speed (rad/s, the model's
+    defaults).
     """
     if out is None:
         return None
-    comp = model.arm_groups["compensating"].index
-    rate = float(np.max(np.abs(v[model.m + comp])))  # rad/s
-    rated = defaults_for(model.name).compensator_speed_rad_s
+    if out.sigma_hbm < warn_sigma:
+        return f"compensator near its singularity (σ = {out.sigma_hbm:.2g} kg·m): it cannot cancel"
     L_task = float(out.extra.get("L_task", 0.0)) if out.extra else 0.0
     residual = float(np.linalg.norm(out.coupling_momentum))
     if L_task > CANCEL_FLOOR and residual > CANCEL_RATIO * L_task:
-        cause = "near its singularity" if out.sigma_hbm < warn_sigma else "it lags the task arm"
-        return f"compensator cannot cancel ({cause}): {100 * residual / L_task:.0f} % of the reaction remains"
+        return f"compensator lags the task arm: {100 * residual / L_task:.0f} % of its reaction remains"
+    comp = model.arm_groups["compensating"].index
+    rate = float(np.max(np.abs(v[model.m + comp])))  # rad/s
+    rated = defaults_for(model.name).compensator_speed_rad_s
     if rate > rated:
         return f"compensator beyond its rated speed: {rate:.1f} rad/s > {rated:g} rad/s"
     return None

@@ -75,7 +75,7 @@ class Outputs:
         if self.steps % PLOT_EVERY == 0:
             self._sample_plots(model, runs, out, shadow_on, suppress)
         if self.steps % READOUT_EVERY == 0:
-            self._update_readouts(model, runs.sim.q, runs.sim.v)
+            self._update_readouts(model, runs.sim.q, runs.sim.v, operated_is_better(runs.sim.law, True))
 
     def _evaluate_reaction(self, runs: RunPair, out: ControlOutput) -> None:
         """The reaction at the step just taken, from its start state, torque and base force."""
@@ -108,7 +108,9 @@ class Outputs:
             )
         )
 
-    def _update_readouts(self, model: FsmsModel, q: np.ndarray, v: np.ndarray | None = None) -> None:
+    def _update_readouts(
+        self, model: FsmsModel, q: np.ndarray, v: np.ndarray | None = None, compensating: bool = True
+    ) -> None:
         L = L_of(self.last) if self.last is not None else 0.0
         readouts = compute_readouts(model, q, L, self.ee_error, self.reaction, self.reaction_t)
         if readouts.dual and v is not None:
@@ -116,8 +118,11 @@ class Outputs:
             quiet = self.steps - self._warned_step < WARN_EVERY
             if cancel is not None and self.readouts.cancel is None and self.warn is not None and not quiet:
                 self._warned_step = self.steps
-                self.warn("Reaction not cancelled", f"The {cancel}; the red arrow is the residual reaction.")
-            readouts = replace(readouts, cancel=cancel)
+                self.warn(
+                    "Reaction not cancelled",
+                    f"{cancel[0].upper()}{cancel[1:]}; the red arrow is the residual reaction.",
+                )
+            readouts = replace(readouts, cancel=cancel, compensating=compensating)
         self.readouts = readouts
 
 

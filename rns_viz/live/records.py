@@ -63,6 +63,7 @@ class Readouts:
     reaction_t: float = math.nan  # s: start time of the step it was evaluated at
     dual: bool = False  # a task arm and a compensating arm: sigma_hbm is S H_bm,2's, sigma_jbar J_1's
     cancel: str | None = None  # why the compensating arm cannot cancel the reaction now (None: it does)
+    compensating: bool = True  # dual arms: the operated run's compensator cancels (the shadow's is held)
 
 
 @dataclass(frozen=True)

@@ -57,6 +57,14 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "curves, where the arm can no longer move the hand outward without moving its centre of mass "
         "along the spring (J-bar loses rank).",
     ),
+    (
+        "rank",
+        "Rank loss of H_bm (TREP, 3R)",
+        False,
+        "Amber poses: the configurations where S H_bm loses rank (Sec. III-B), every link along the base's "
+        "swing axis. There small joint motions give no reaction, but only to first order, only at these "
+        "isolated poses, and the inverse of (9)-(10) blows up near them: the paper does not rely on it.",
+    ),
 )
 
 
