@@ -17,6 +17,7 @@ For a model with ``[arms]`` (trep2) the live session runs :class:`~rns_viz.contr
 from __future__ import annotations
 
 import math
+from functools import cache
 
 import numpy as np
 import pinocchio as pin
@@ -36,6 +37,12 @@ CANCEL_RATIO = 0.05  # a residual L above this fraction of the task arm's moment
 def is_dual(model: FsmsModel) -> bool:
     """The model has a task arm and a compensating arm (``[arms]`` of its parameter file)."""
     return "task" in model.arm_groups and "compensating" in model.arm_groups
+
+
+@cache
+def dual_by_name(name: str) -> bool:
+    """:func:`is_dual` of a bundled model, by name."""
+    return is_dual(FsmsModel.from_name(name))
 
 
 def dual_law(model: FsmsModel, gains: Gains, suppress: bool, task: TaskSample | None, shadow: bool) -> CompensatingLaw:
