@@ -4,12 +4,15 @@ Run on demand (Debian chromium needed for the browser scenario):
 
     python benchmarks/bench_app.py                     # TREP, 60 s per scenario
     python benchmarks/bench_app.py --model planar3r --seconds 20
+    python benchmarks/bench_app.py --model trep2 --only browser     # dual arms (issue 13)
 
 The app runs in its own process (its CPU time is measured there, with time.process_time over all
 its threads); clients run in this process. Scenarios, each with the shadow run on:
 
 1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
-   its reactionless path; 3R: kicks) and the base is kicked every 5 s from the page's button;
+   its reactionless path; 3R: kicks; trep2: the task arm's target jumps between two points 5 cm
+   apart every 2.5 s, server side, the compensator cancelling, the shadow's held) and the base is
+   kicked every 5 s from the page's button;
 2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
@@ -17,12 +20,14 @@ its threads); clients run in this process. Scenarios, each with the shadow run o
 Printed per scenario: real-time factor (target >= 0.99), scene update rate (frames sent, target
 >= 30 Hz) and as received by a client, plot update rate (target >= 10 Hz), server CPU as % of
 one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms).
+The machine's load average is printed before and after: figures from a loaded machine are not the app's.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -30,6 +35,8 @@ import threading
 import time
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # tests/ holds the browser and websocket helpers
@@ -52,6 +59,8 @@ def serve(model: str) -> None:
         "handle": TARGET_HANDLE,
     }
     print(json.dumps(info), file=out, flush=True)
+    if model == "trep2":  # the task arm keeps moving: the target jumps 5 cm every 2.5 s
+        threading.Thread(target=move_target, args=(app,), daemon=True).start()
     for line in sys.stdin:
         if line.strip() == "quit":
             break
@@ -71,6 +80,17 @@ def serve(model: str) -> None:
         s._latencies.clear()
         print(json.dumps(stats), file=out, flush=True)
     app.stop()
+
+
+def move_target(app: Any, period: float = 2.5) -> None:
+    """trep2: send the task arm's target back and forth between two points 5 cm apart (server side)."""
+    s = app.session
+    home = app.model.ee_position(app.model.spec.default_configuration)[:2]
+    k = 0
+    while not s._stop:
+        k += 1
+        s.set_target(home + np.array([0.05 * (k % 2), 0.0]), final=True)
+        time.sleep(period)
 
 
 # ---------------------------------------------------------------- client side
@@ -203,7 +223,7 @@ def scenario_latency(model: str, seconds: float) -> None:
         while time.monotonic() < deadline:
             k += 1
             if k % 2:  # a small target move (0.5 % of the arm's reach) and back
-                dx = 0.001 if model == "trep" else 0.015
+                dx = 0.015 if model == "planar3r" else 0.001
                 ws.drag(srv.info["handle"], (ee[0] + dx * (k % 4 == 1), ee[1], ee[2]), "update")
             else:
                 ws.set_value(srv.info["g_b"], 10.0 + 0.1 * (k % 4))
@@ -226,7 +246,7 @@ def scenario_latency(model: str, seconds: float) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", default="trep", choices=("trep", "planar3r"))
+    parser.add_argument("--model", default="trep", choices=("trep", "planar3r", "trep2"))
     parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
     parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
@@ -235,12 +255,14 @@ def main() -> None:
         serve(args.model)
         return
     print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario, 2 cores shared")
+    print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())} (1, 5, 15 min)")
     if args.only in (None, "browser"):
         scenario_browser(args.model, args.seconds)
     if args.only in (None, "clients"):
         scenario_clients(args.model, args.seconds)
     if args.only in (None, "latency"):
         scenario_latency(args.model, min(args.seconds, 20.0))
+    print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())} (1, 5, 15 min)")
 
 
 if __name__ == "__main__":
