@@ -207,11 +207,12 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             hint="How fast the arm moves along the path, the paper's ū in 1/(kg·m·s) (Fig. 12 uses 30); "
             "the line above turns it into joint speeds.",
         )
-    with gui.add_folder("Target (planar 3R)") as target_folder:
+    with gui.add_folder("Target (planar 3R, TREP + compensator)") as target_folder:
         gui.add_markdown(
-            "Drag the **green handle** in the scene (x and y only). The arm follows with reactionless "
-            "end-effector control, Eq. (24). Targets outside the reactionless reachable set (lilac dots) "
-            "are clamped to its nearest point."
+            "Drag the **green handle** in the scene (x and y only). Planar 3R: the arm follows with "
+            "reactionless end-effector control, Eq. (24); targets outside the reactionless reachable set "
+            "(lilac dots) are clamped to its nearest point. TREP + compensator: the task arm follows "
+            "anywhere in its workspace and the second arm cancels its reaction on the beam."
         )
         target_speed = gui.add_slider(
             "Target speed (m/s)",

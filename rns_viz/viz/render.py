@@ -314,6 +314,7 @@ class Renderer:
         joint_gains = on_path and st.law != "velocity"
         g.gains["G_p"].visible = g.gains["G_d"].visible = task_gains
         g.gains["k_p"].visible = g.gains["k_d"].visible = joint_gains
+        g.law.disabled = is_dual(self.model)  # one law for dual arms: the compensating law
 
 
 class _Seen:
