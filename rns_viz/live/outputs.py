@@ -24,6 +24,7 @@ from rns_viz.model import FsmsModel
 
 PLOT_EVERY = 20  # steps between plot samples (50 Hz: a 10 s window is 500 samples)
 READOUT_EVERY = 50  # steps between readout updates (20 Hz)
+HELD = "compensator held in this run (the shadow run's cancels)"
 WARN_EVERY = 5000  # steps: at most one "not cancelled" notice per 5 s
 REACTION_EVERY = 4  # steps between evaluations of the arm's reaction (250 Hz: every published snapshot)
 
@@ -113,7 +114,9 @@ class Outputs:
     ) -> None:
         L = L_of(self.last) if self.last is not None else 0.0
         readouts = compute_readouts(model, q, L, self.ee_error, self.reaction, self.reaction_t)
-        if readouts.dual and v is not None:
+        if readouts.dual and v is not None and not compensating:  # a preset holds it on purpose
+            readouts = replace(readouts, cancel=HELD, compensating=False)
+        elif readouts.dual and v is not None:
             cancel = compensation_state(model, self.last, v, readouts.warn_hbm)
             quiet = self.steps - self._warned_step < WARN_EVERY
             if cancel is not None and self.readouts.cancel is None and self.warn is not None and not quiet:
