@@ -22,8 +22,8 @@ trep2 (TREP with a compensating second arm, Sec. III-B): only the compensating l
 acceleration like (15), with TREP's (15) gains g_b = 10 (now through the compensator alone) and
 G_m = 2 on the coupling momentum; TREP's kick (the beam and tip are TREP's). The task target moves
 at 0.1 m/s (half the task arm's reach per second): the compensator, about 1.1 times as fast as the
-task arm to cancel it, then turns at 1-2 rad/s. Its rated speed, 6 rad/s, is an assumption (the
-paper gives none): above it the app says the compensator is asked too much.
+task arm to cancel it, then turns at 1-2 rad/s, far below its joints' URDF velocity limits
+(20 rad/s), above which the app says the compensator is asked too much.
 
 boom7 (the spatial model; not yet served by the app): law (15) with g_b = 10, G_m = 2 on all six
 tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
@@ -33,7 +33,6 @@ coordinate alone it would push the stiff axial mode (170 Hz, 1e-7 m).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 from rns_viz.control import Gains, LawKind
@@ -48,7 +47,6 @@ class ModelDefaults:
     kick_range_N: float = 5.0  # the kick slider's half range
     exaggeration: float = 10.0  # drawn deflection factor
     target_speed_m_s: float = 0.5  # speed limit of the smoothed end-effector target
-    compensator_speed_rad_s: float = math.inf  # rated joint speed of a compensating arm (dual-arm models)
 
     def gains_for(self, law: LawKind) -> Gains:
         return self.gains.get(law, FALLBACK_GAINS)
@@ -97,7 +95,6 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         kick_range_N=5.0,
         exaggeration=10.0,
         target_speed_m_s=0.1,
-        compensator_speed_rad_s=6.0,
     ),
 }
 GENERIC_DEFAULTS = ModelDefaults(law="acceleration")

@@ -11,7 +11,7 @@ For a model with ``[arms]`` (trep2) the live session runs :class:`~rns_viz.contr
   plots show what compensation saves.
 
 :func:`compensation_state` says when the compensator cannot cancel: near its own singularity
-(sigma_min(S H_bm,2) small) or when the task asks more of it than its rated speed.
+(sigma_min(S H_bm,2) small) or when the task asks more of it than its joints' velocity limits.
 """
 
 from __future__ import annotations
@@ -24,7 +24,6 @@ import pinocchio as pin
 
 from rns_viz.control import ControlOutput, Gains, TaskSample
 from rns_viz.control.compensation import CompensatingLaw
-from rns_viz.defaults import defaults_for
 from rns_viz.live.follower import Follower
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
@@ -167,8 +166,7 @@ def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarra
 
     Near its singularity: sigma_min(S H_bm,2) below ``warn_sigma`` (kg m), where the damped inverse of
     (9)-(10) gives up cancelling. Lagging: the residual coupling momentum exceeds CANCEL_RATIO of the
-    task arm's. Beyond its speed: a compensator joint faster than its rated speed (rad/s, the model's
-    defaults).
+    task arm's. Beyond its speed: a compensator joint faster than its URDF velocity limit (rad/s).
     """
     if out is None:
         return None
@@ -178,11 +176,12 @@ def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarra
     residual = float(np.linalg.norm(out.coupling_momentum))
     if L_task > CANCEL_FLOOR and residual > CANCEL_RATIO * L_task:
         return f"compensator lags the task arm: {100 * residual / L_task:.0f} % of its reaction remains"
-    comp = model.arm_groups["compensating"].index
-    rate = float(np.max(np.abs(v[model.m + comp])))  # rad/s
-    rated = defaults_for(model.name).compensator_speed_rad_s
-    if rate > rated:
-        return f"compensator beyond its rated speed: {rate:.1f} rad/s > {rated:g} rad/s"
+    joints = model.m + model.arm_groups["compensating"].index
+    over = np.abs(v[joints]) - model.pin_model.velocityLimit[joints]  # rad/s beyond the URDF's limits
+    if float(np.max(over)) > 0.0:
+        k = int(np.argmax(over))
+        rate, limit = abs(float(v[joints[k]])), float(model.pin_model.velocityLimit[joints[k]])
+        return f"compensator beyond its speed: {rate:.1f} rad/s > its {limit:g} rad/s limit"
     return None
 
 
