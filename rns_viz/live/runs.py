@@ -1,5 +1,6 @@
 """The operated run and its shadow: two simulations of one model that get the same inputs and kicks,
-with vibration suppression the other way in the shadow, so suppression on and off are compared live.
+with vibration suppression the other way in the shadow, so suppression on and off are compared live
+(a dual-arm model's shadow holds its compensating arm instead: compensation on and off).
 
 :class:`RunPair` owns both simulators, their laws and their kick schedules. Only the simulation loop
 calls it, between steps.
