@@ -72,7 +72,8 @@ class MujocoDriven:
         self.qadr = _as_slice(self.plant.qpos_index)
         self.dadr = _as_slice(self.plant.dof_index)
         self.arm = _as_slice(self.plant.dof_index[model.m :])
-        q0, v0 = initial_state(model)
+        at_rest = (model.q(model.spec.default_configuration), np.zeros(model.nv))
+        q0, v0 = initial_state(model) if law is None else at_rest  # a given law's run sets its own state
         self.data.qpos[self.qadr] = q0
         self.data.qvel[self.dadr] = v0
         self.t = 0.0
@@ -192,7 +193,7 @@ def dual_variants() -> dict[Hashable, Callable[[], None]]:
     for sim in (on, held):
         sim.run(0.5)  # the circle is under way
     mj = MujocoDriven(on.model, trep2_circle(True).law)
-    mj.data.qpos[mj.qadr], mj.t = on.q, on.t
+    mj.data.qpos[mj.qadr], mj.data.qvel[mj.dadr], mj.t = on.q, on.v, on.t
     return {("trep2", "step"): on.step, ("trep2", "held step"): held.step, ("trep2", "MuJoCo plant"): mj.step}
 
 
