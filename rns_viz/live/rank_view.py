@@ -24,6 +24,7 @@ RANK_HINT = (
     "because these are isolated poses, reactionless only to first order, and the inverse of (9)-(10) "
     "blows up near them."
 )
+RANK_LABEL = "S H_bm loses rank: links along the swing axis (reactionless to first order only; not relied on)"
 SEEDS_PER_JOINT = {2: 12, 3: 6}  # grid nodes per joint of the search (3 joints: 216 seeds, under 1 s)
 
 

@@ -2,7 +2,8 @@
 
 Data from the live layer (:func:`rns_viz.live.rank_view.rank_overlay`); computed the first time the
 *Show in the scene* box is ticked (under a second for the 3R), then kept. Each pose is drawn as the
-arm's links (line segments) with a dot at its end effector, and a label with the one-sentence why.
+arm's links (line segments) with a dot at its end effector, and a short label; the full sentence of
+why is the checkbox's hint (``RANK_HINT``).
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from rns_viz.live.rank_view import RANK_HINT, RankOverlay, rank_overlay
+from rns_viz.live.rank_view import RANK_LABEL, RankOverlay, rank_overlay
 from rns_viz.model import FsmsModel
 from rns_viz.viz.style import SceneStyle
 
@@ -67,7 +68,7 @@ class RankScene:
             ),
             self.server.scene.add_label(
                 f"{self.NODE}/label",
-                RANK_HINT,
+                RANK_LABEL,
                 position=tuple(ends[int(np.argmax(ends[:, 0]))] + np.array([0.0, 2.0 * st.marker_radius, 0.0])),
                 anchor="bottom-left",
                 visible=False,

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import viser
 
+from rns_viz.live.rank_view import RANK_HINT
 from rns_viz.viz.connections import Connections
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
@@ -61,9 +62,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "rank",
         "Rank loss of H_bm (TREP, 3R)",
         False,
-        "Amber poses: the configurations where S H_bm loses rank (Sec. III-B), every link along the base's "
-        "swing axis. There small joint motions give no reaction, but only to first order, only at these "
-        "isolated poses, and the inverse of (9)-(10) blows up near them: the paper does not rely on it.",
+        "Amber poses (Sec. III-B, the fourth case). " + RANK_HINT,
     ),
 )
 
