@@ -5,12 +5,15 @@ Run on demand (Debian chromium needed for the browser scenario):
     python benchmarks/bench_app.py                     # TREP, 60 s per scenario
     python benchmarks/bench_app.py --model planar3r --seconds 20
     python benchmarks/bench_app.py --teach --seconds 70  # issue 11: teaching views and recording, vs off
+    python benchmarks/bench_app.py --model trep2 --only browser     # dual arms (issue 13)
 
 The app runs in its own process (its CPU time is measured there, with time.process_time over all
 its threads); clients run in this process. Scenarios, each with the shadow run on:
 
 1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
-   its reactionless path; 3R: kicks) and the base is kicked every 5 s from the page's button;
+   its reactionless path; 3R: kicks; trep2: the task arm's target jumps between two points 5 cm
+   apart every 2.5 s, server side, the compensator cancelling, the shadow's held) and the base is
+   kicked every 5 s from the page's button;
 2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
@@ -25,12 +28,14 @@ off, then with all of them on and the recorder recording (as the app always does
 the figures above and the server's resident memory; then the ring buffer's size for 60 s, the memory
 it added over the baseline, and the memory a 60 s replay takes (the immutable copy it replays).
 Use ``--seconds 60`` or more so the ring has filled once.
+The machine's load average is printed before and after: figures from a loaded machine are not the app's.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -38,6 +43,8 @@ import threading
 import time
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # tests/ holds the browser and websocket helpers
@@ -79,6 +86,8 @@ def serve(model: str, teach: str | None = None) -> None:
         "handle": TARGET_HANDLE,
     }
     print(json.dumps(info), file=out, flush=True)
+    if model == "trep2":  # the task arm keeps moving: the target jumps 5 cm every 2.5 s
+        threading.Thread(target=move_target, args=(app,), daemon=True).start()
     for line in sys.stdin:
         if line.strip() == "quit":
             break
@@ -104,6 +113,17 @@ def serve(model: str, teach: str | None = None) -> None:
         s._latencies.clear()
         print(json.dumps(stats), file=out, flush=True)
     app.stop()
+
+
+def move_target(app: Any, period: float = 2.5) -> None:
+    """trep2: send the task arm's target back and forth between two points 5 cm apart (server side)."""
+    s = app.session
+    home = app.model.ee_position(app.model.spec.default_configuration)[:2]
+    k = 0
+    while not s._stop:
+        k += 1
+        s.set_target(home + np.array([0.05 * (k % 2), 0.0]), final=True)
+        time.sleep(period)
 
 
 # ---------------------------------------------------------------- client side
@@ -253,7 +273,7 @@ def scenario_latency(model: str, seconds: float) -> None:
         while time.monotonic() < deadline:
             k += 1
             if k % 2:  # a small target move (0.5 % of the arm's reach) and back
-                dx = 0.001 if model == "trep" else 0.015
+                dx = 0.015 if model == "planar3r" else 0.001
                 ws.drag(srv.info["handle"], (ee[0] + dx * (k % 4 == 1), ee[1], ee[2]), "update")
             else:
                 ws.set_value(srv.info["g_b"], 10.0 + 0.1 * (k % 4))
@@ -276,7 +296,7 @@ def scenario_latency(model: str, seconds: float) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", default="trep", choices=("trep", "planar3r"))
+    parser.add_argument("--model", default="trep", choices=("trep", "planar3r", "trep2"))
     parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
     parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
     parser.add_argument("--teach", action="store_true", help="issue 11: one browser, teaching views off then on")
@@ -298,6 +318,7 @@ def main() -> None:
         scenario_clients(args.model, args.seconds)
     if args.only in (None, "latency"):
         scenario_latency(args.model, min(args.seconds, 20.0))
+    print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())} (1, 5, 15 min)")
 
 
 if __name__ == "__main__":

@@ -14,6 +14,11 @@ extension built the law and RK4 run in C++ (rns_viz.sim.native). Baselines:
   with the generated 7-DOF arm). It is also a check: its trajectory must equal the simulator's.
 - "pinocchio calls": crba + nonLinearEffects + 4 x aba alone, the floor of any step built on them.
 
+trep2 (TREP with a compensating second arm, Sec. III-B) runs its own law, the CompensatingLaw tracking
+the trep2-circle preset's circle, in Python (no native step for it): its row gives the step with the
+compensator cancelling, with it held (the live shadow run), their sum (what the live app steps per
+1 ms), and the same law object driving MuJoCo's plant.
+
 Timing: every variant is timed per step with perf_counter, in interleaved rounds (the machine is
 shared and noisy), after warm-up; medians in microseconds. "sustained" is a long ``Simulator.run``
 divided by its steps. The real-time factor is simulated time / wall time at dt = 1 ms.
@@ -23,12 +28,14 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import statistics
 import sys
 import tempfile
 import time
 from collections.abc import Callable, Hashable
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -39,6 +46,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # for tests.ora
 from benchmarks.oracles import DT, Straightforward, arm7_model, initial_state
 from rns_viz.control import AccelerationLaw, Gains
 from rns_viz.model import FsmsModel
+from rns_viz.scenarios import trep2_circle
 from rns_viz.sim import Simulator
 from rns_viz.sim import native as native_step
 from tests.oracles.mujoco_replay import build_model
@@ -54,17 +62,18 @@ def rns_viz_step(model: FsmsModel, log_ee: bool = True, native: bool = True) -> 
 
 
 class MujocoDriven:
-    """The same AccelerationLaw, with MuJoCo's RK4 (``mj_step``) as the plant."""
+    """The same AccelerationLaw (or ``law``), with MuJoCo's RK4 (``mj_step``) as the plant."""
 
-    def __init__(self, model: FsmsModel) -> None:
+    def __init__(self, model: FsmsModel, law: Callable[..., Any] | None = None) -> None:
         spec = model.spec
         self.plant = build_model(spec.urdf_path, spec.base.joints, model.K_b, model.D_b, model.D_m, DT)
         self.data = mujoco.MjData(self.plant.model)
-        self.law = AccelerationLaw(model, GAINS[model.name])
+        self.law = law if law is not None else AccelerationLaw(model, GAINS[model.name])
         self.qadr = _as_slice(self.plant.qpos_index)
         self.dadr = _as_slice(self.plant.dof_index)
         self.arm = _as_slice(self.plant.dof_index[model.m :])
-        q0, v0 = initial_state(model)
+        at_rest = (model.q(model.spec.default_configuration), np.zeros(model.nv))
+        q0, v0 = initial_state(model) if law is None else at_rest  # a given law's run sets its own state
         self.data.qpos[self.qadr] = q0
         self.data.qvel[self.dadr] = v0
         self.t = 0.0
@@ -178,6 +187,16 @@ def trajectories_agree(model: FsmsModel, steps: int = 2000) -> tuple[float, floa
     return worst_python, worst_plain, worst_mj
 
 
+def dual_variants() -> dict[Hashable, Callable[[], None]]:
+    """trep2's steps: compensating, held (the live shadow), and the compensating law on MuJoCo's plant."""
+    on, held = trep2_circle(True), trep2_circle(False)
+    for sim in (on, held):
+        sim.run(0.5)  # the circle is under way
+    mj = MujocoDriven(on.model, trep2_circle(True).law)
+    mj.data.qpos[mj.qadr], mj.data.qvel[mj.dadr], mj.t = on.q, on.v, on.t
+    return {("trep2", "step"): on.step, ("trep2", "held step"): held.step, ("trep2", "MuJoCo plant"): mj.step}
+
+
 # -- report -----------------------------------------------------------------------------------------
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -188,10 +207,13 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         models = [FsmsModel.from_name("trep"), FsmsModel.from_name("planar3r"), arm7_model(Path(tmp))]
         variants = {(model.name, name): fn for model in models for name, fn in step_variants(model).items()}
+        variants.update(dual_variants())
         medians = median_us(variants, args.samples, args.rounds)
         results: dict[str, dict] = {model.name: {"n": model.n} for model in models}
+        dual = {name: value for (model_name, name), value in medians.items() if model_name == "trep2"}
         for (model_name, name), value in medians.items():
-            results[model_name][name] = value
+            if model_name != "trep2":
+                results[model_name][name] = value
         for model in models:
             results[model.name]["sustained"] = sustained_us(model, 5000)
             results[model.name]["ee fill"] = ee_fill_us(model)
@@ -203,7 +225,7 @@ def main() -> None:
     print(f"Closed-loop step, AccelerationLaw (15), RK4 with torque held over dt = {DT * 1e3:g} ms; medians in µs")
     print(f"step: {native}")
     versions = f"python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}"
-    print(f"({versions}, mujoco {mujoco.__version__})")
+    print(f"({versions}, mujoco {mujoco.__version__}); load average {os.getloadavg()[0]:.2f} (1 min)")
     print()
     header = (
         "model",
@@ -233,6 +255,15 @@ def main() -> None:
             f"{name:<10}{r['pinocchio calls']:>17.1f}{r['law alone']:>11.1f}{r['mj_step alone']:>15.1f}"
             f"{r['step, log_ee off']:>12.1f}{r['step']:>11.1f}{r['ee fill']:>13.1f}"
         )
+    print()
+    both = dual["step"] + dual["held step"]
+    print("trep2 (4 arm DOF), CompensatingLaw on the circle preset, Python step (medians, µs)")
+    header = ("compensating", "RTF 1kHz", "held", "with shadow", "RTF", "MuJoCo plant", "ratio")
+    print("{:<14}{:>9}{:>8}{:>13}{:>7}{:>14}{:>7}".format(*header))
+    print(
+        f"{dual['step']:<14.1f}{1e3 / dual['step']:>8.2f}x{dual['held step']:>8.1f}{both:>13.1f}{1e3 / both:>6.2f}x"
+        f"{dual['MuJoCo plant']:>14.1f}{dual['step'] / dual['MuJoCo plant']:>7.2f}"
+    )
     print()
     print("Same trajectory? max |x_b difference| over 2 s against Simulator.step (m)")
     for name, r in results.items():

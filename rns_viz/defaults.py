@@ -18,6 +18,13 @@ Kicks. "An arbitrary external force" (Sec. VII-D): a half-sine push on the base 
 31 kg base (0.64 N s, about 1.1 cm); law (15) absorbs a deflection by moving the arm's centre of
 mass, so a much larger kick needs more than the arm's reach and drives it into H_bm = 0.
 
+trep2 (TREP with a compensating second arm, Sec. III-B): only the compensating law, resolved
+acceleration like (15), with TREP's (15) gains g_b = 10 (now through the compensator alone) and
+G_m = 2 on the coupling momentum; TREP's kick (the beam and tip are TREP's). The task target moves
+at 0.1 m/s (half the task arm's reach per second): the compensator, about 1.1 times as fast as the
+task arm to cancel it, then turns at 1-2 rad/s, far below its joints' URDF velocity limits
+(20 rad/s), above which the app says the compensator is asked too much.
+
 boom7 (the spatial model; not yet served by the app): law (15) with g_b = 10, G_m = 2 on all six
 tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
 about 1.3 mm of a 4 m boom, drawn 50x). Its kick needs a direction: along the first base
@@ -39,6 +46,7 @@ class ModelDefaults:
     kick_duration_s: float = 0.1  # half-sine duration of a kick
     kick_range_N: float = 5.0  # the kick slider's half range
     exaggeration: float = 10.0  # drawn deflection factor
+    target_speed_m_s: float = 0.5  # speed limit of the smoothed end-effector target
 
     def gains_for(self, law: LawKind) -> Gains:
         return self.gains.get(law, FALLBACK_GAINS)
@@ -78,6 +86,15 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         kick_duration_s=0.1,
         kick_range_N=20.0,
         exaggeration=50.0,
+    ),
+    "trep2": ModelDefaults(
+        law="acceleration",
+        gains={"acceleration": Gains(g_b=10.0, g_m=2.0)},
+        kick_peak_N=0.8,
+        kick_duration_s=0.1,
+        kick_range_N=5.0,
+        exaggeration=10.0,
+        target_speed_m_s=0.1,
     ),
 }
 GENERIC_DEFAULTS = ModelDefaults(law="acceleration")

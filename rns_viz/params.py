@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 
 ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
-MODEL_NAMES = ("trep", "planar3r")  # the models the live app serves
-BUNDLED_MODELS = (*MODEL_NAMES, "boom7", "trep2")  # every model in assets/, for FsmsModel.from_name
+MODEL_NAMES = ("trep", "planar3r", "trep2")  # the models the live app serves
+BUNDLED_MODELS = (*MODEL_NAMES, "boom7")  # every model in assets/, for FsmsModel.from_name
 TASK_AXES = ("x", "y", "z")
 
 

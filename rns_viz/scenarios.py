@@ -4,7 +4,8 @@ redundancy on trep2 (Sec. III-B: a compensating second arm).
 
 Each preset builds a ready :class:`Simulator` with the paper's parameters. Choices the paper
 leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS,
-apart from SCENARIOS, until the live app serves that model, and so are trep2's in DUAL_SCENARIOS;
+apart from SCENARIOS, until the live app serves that model; trep2's are in DUAL_SCENARIOS, which the live
+app offers beside SCENARIOS (LIVE_SCENARIOS);
 ``run_scenario`` runs all of them.
 """
 
@@ -308,6 +309,7 @@ DUAL_SCENARIOS: dict[str, Scenario] = {
     )
 }
 ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}
+LIVE_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **DUAL_SCENARIOS}  # the presets the live app offers
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:

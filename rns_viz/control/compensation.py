@@ -35,6 +35,8 @@ from rns_viz.profiles import quintic
 from rns_viz.rns import damped_pinv
 
 LIMIT_MARGIN = math.radians(30.0)  # rad: the limit term of the avoidance measure acts this close to a limit
+AVOID_EVERY = 10  # calls between evaluations of the avoidance gradient (a slow null-space drift; its
+# RNEA derivatives cost as much as the rest of the law); P_2 is applied to it at every call
 
 
 @dataclass(frozen=True)
@@ -110,6 +112,8 @@ class CompensatingLaw:
         self._cols = m + self.comp  # compensator columns of M
         self._t = 0.0
         self._rehold = False
+        self._grad: np.ndarray | None = None  # the avoidance gradient in use, and calls since it was taken
+        self._grad_age = 0
 
     # -- ControlLaw protocol ------------------------------------------------------------------
     def retune(self, gains: Gains) -> None:
@@ -187,7 +191,10 @@ class CompensatingLaw:
         if self.compensate:
             g_b = g.g_b if self.suppress else 0.0
             y = g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g.g_m * cp.coupling_momentum - H1 @ acc1
-            u2 = self.avoid_gain * self.avoidance_gradient(q, H2) - self.null_damping * thetadot2
+            if self._grad is None or self._grad_age >= AVOID_EVERY:
+                self._grad, self._grad_age = self.avoidance_gradient(q, H2), 0
+            self._grad_age += 1
+            u2 = self.avoid_gain * self._grad - self.null_damping * thetadot2
             acc2 = inv2.inverse @ y + u2 - inv2.inverse @ (H2 @ u2)  # H_bm,2^+ y + P_2 u_2, Eqs. (9), (15)
         else:
             if self._rehold:

@@ -33,6 +33,7 @@ from rns_viz.analysis import (
 )
 from rns_viz.control import Gains, LawKind
 from rns_viz.live import jobs
+from rns_viz.live.dual import dual_by_name
 from rns_viz.live.worker import Worker
 from rns_viz.sim import Simulator
 
@@ -96,6 +97,8 @@ class GainExplorer:
         self._key, self._loop, self._loops = key, None, None
         paper = tuple((p.label, p.g_b, p.g_m) for p in PAPER_GAINS.get((model, law), ()))
         self._publish(map=None, current=None, locus_g_b=None, locus_g_m=None, paper=paper, authority=None)
+        if dual_by_name(model):  # its linearised loop would be law (15)'s on all joints, not the compensating law
+            return
 
         def job() -> tuple[LinearLoop, GainMap, tuple[Modes, Locus, Locus]]:
             loop = jobs.call("linear_loop", model, law, theta)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from rns_viz.live.background import Background
+from rns_viz.live.dual import is_dual
 from rns_viz.live.path_table import PathTable
 from rns_viz.live.reach import ReachRegion
 from rns_viz.live.records import Overlays
@@ -34,6 +35,8 @@ class Geometry:
     ) -> None:
         """The current reactionless path (1-D RNS) or reachable set (otherwise) through ``theta``."""
         self.shown_level = field.potentials(np.asarray(theta, dtype=float)[None])[0]
+        if is_dual(model):  # the task arm goes anywhere in its workspace: no reactionless set to show
+            return
         if model.n - len(model.selected) == 1:
             self.background.path_table(epoch, model.name, theta, default)
             self.background.family(epoch, model.name)

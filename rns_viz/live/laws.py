@@ -31,6 +31,7 @@ from rns_viz.control import (
     TrackJointReference,
     VelocityLaw,
 )
+from rns_viz.live.dual import dual_law, is_dual
 from rns_viz.model import FsmsModel
 
 LAW_LABELS: dict[LawKind, str] = {
@@ -60,8 +61,15 @@ def build_law(
     joint: JointSample,
     task: TaskSample | None = None,
     joint_move: bool = False,
+    shadow: bool = False,
 ) -> LiveLaw:
-    """A live law; a ``task`` sample selects Eq. (24) tracking for (15)/(16); ``joint_move`` the servo."""
+    """A live law; a ``task`` sample selects Eq. (24) tracking for (15)/(16); ``joint_move`` the servo.
+
+    A dual-arm model (:mod:`rns_viz.live.dual`) runs the compensating law whatever ``kind`` (the
+    operator's law choice is refused there), its compensator held still in the ``shadow`` run.
+    """
+    if is_dual(model):
+        return LiveLaw(dual_law(model, gains, suppress, task, shadow), follows_task=True)
     if joint_move and kind != "velocity":
         return LiveLaw(JointServo(model, gains, joint), follows_task=False)
     if kind == "velocity":

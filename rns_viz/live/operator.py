@@ -11,6 +11,9 @@ point-to-point comparison leaves the path on a joint-space quintic between the s
 
 Multi-dimensional RNS (planar 3R): the target is clamped to the reactionless reachable set and
 followed by the :class:`ResolvedRate` reference.
+
+Dual arms (trep2): the target is clamped to the task arm's workspace and followed by the task arm
+(:class:`~rns_viz.live.dual.TaskTarget`); the compensating arm cancels the reaction.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.control import JointSample, TaskSample
+from rns_viz.live.dual import TaskTarget, is_dual
 from rns_viz.live.path_table import PathTable
 from rns_viz.live.reach import ReachRegion
 from rns_viz.live.references import PathFollower, ResolvedRate, SigmaMotion
@@ -70,8 +74,12 @@ class Operator:
         if self.on_path:
             self.follower = PathFollower(model, theta0)
             self.motion = SigmaMotion(0.0, ubar_speed)
+        elif is_dual(model):  # no reactionless restriction: anywhere in the task arm's workspace
+            self.rr = TaskTarget(model, theta0, v_max=target_speed)  # type: ignore[assignment]
+            self.reach = self.rr.workspace  # type: ignore[assignment]
         else:
             self.rr = ResolvedRate(model, theta0, v_max=target_speed)
+        if not self.on_path:
             self.task = TaskSample.held(self.rr.x)
             self.target = self._point(self.rr.x)
         self._moving = False
@@ -174,6 +182,8 @@ class Operator:
         x, y = self.target[:2]  # type: ignore[index]
         if self.on_path:
             where = "The arm moves without reaction only along its current reactionless path"
+        elif isinstance(self.rr, TaskTarget):
+            where = "That target is outside the task arm's workspace"
         else:
             where = "That target is outside the set reachable without reaction from this configuration"
         return f"{where}; it goes to the nearest point ({x:.2f}, {y:.2f}) m instead."

@@ -8,10 +8,13 @@ mm, L in kg m/s and the end-effector error in mm; readouts are SI.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
 from rns_viz.control import ControlOutput
+from rns_viz.live.dual import compensation_state, operated_is_better
 from rns_viz.live.plots import PlotBuffers
 from rns_viz.live.reaction import ReactionProbe
 from rns_viz.live.readouts import compute_readouts
@@ -22,6 +25,8 @@ from rns_viz.model import FsmsModel
 
 PLOT_EVERY = 20  # steps between plot samples (50 Hz: a 10 s window is 500 samples)
 READOUT_EVERY = 50  # steps between readout updates (20 Hz)
+HELD = "compensator held in this run (the shadow run's cancels)"
+WARN_EVERY = 5000  # steps: at most one "not cancelled" notice per 5 s
 REACTION_EVERY = 4  # steps between evaluations of the arm's reaction (250 Hz: every published snapshot)
 
 
@@ -37,9 +42,10 @@ def reference_point(model: FsmsModel, out: ControlOutput | None) -> np.ndarray |
 
 
 class Outputs:
-    def __init__(self, plot_capacity: int = 500) -> None:
+    def __init__(self, plot_capacity: int = 500, warn: Callable[[str, str], None] | None = None) -> None:
         self.plots = PlotBuffers(plot_capacity)
         self.recorder = Recorder()  # the last minute of steps, for replay and export
+        self.warn = warn  # warn(title, body): tells everyone when a compensating arm stops cancelling
         self.steps = 0  # steps booked since the session started (never reset: readers wait on it)
         self._probe: ReactionProbe | None = None
         self.restart(None)
@@ -54,6 +60,7 @@ class Outputs:
         self._pre: tuple[float, np.ndarray] | None = None  # (t, x = (q, v)) the next evaluated step starts from
         self.ee_error = math.nan  # m
         self.readouts = Readouts()
+        self._warned_step = -WARN_EVERY
         if model is not None and q is not None:
             self._update_readouts(model, q)
 
@@ -73,7 +80,7 @@ class Outputs:
         if self.steps % PLOT_EVERY == 0:
             self._sample_plots(model, runs, out, shadow_on, suppress)
         if self.steps % READOUT_EVERY == 0:
-            self._update_readouts(model, runs.sim.q)
+            self._update_readouts(model, runs.sim.q, runs.sim.v, operated_is_better(runs.sim.law, True))
 
     def _evaluate_reaction(self, runs: RunPair, out: ControlOutput) -> None:
         """The reaction at the step just taken, from its start state, torque and base force."""
@@ -102,13 +109,28 @@ class Outputs:
                 L_of(out),
                 L_of(shadow_out) if shadow_out is not None else math.nan,
                 self.ee_error * 1e3,
-                float(suppress),
+                float(operated_is_better(sim.law, suppress)),
             )
         )
 
-    def _update_readouts(self, model: FsmsModel, q: np.ndarray) -> None:
+    def _update_readouts(
+        self, model: FsmsModel, q: np.ndarray, v: np.ndarray | None = None, compensating: bool = True
+    ) -> None:
         L = L_of(self.last) if self.last is not None else 0.0
-        self.readouts = compute_readouts(model, q, L, self.ee_error, self.reaction, self.reaction_t)
+        readouts = compute_readouts(model, q, L, self.ee_error, self.reaction, self.reaction_t)
+        if readouts.dual and v is not None and not compensating:  # a preset holds it on purpose
+            readouts = replace(readouts, cancel=HELD, compensating=False)
+        elif readouts.dual and v is not None:
+            cancel = compensation_state(model, self.last, v, readouts.warn_hbm)
+            quiet = self.steps - self._warned_step < WARN_EVERY
+            if cancel is not None and self.readouts.cancel is None and self.warn is not None and not quiet:
+                self._warned_step = self.steps
+                self.warn(
+                    "Reaction not cancelled",
+                    f"{cancel[0].upper()}{cancel[1:]}; the red arrow is the residual reaction.",
+                )
+            readouts = replace(readouts, cancel=cancel, compensating=compensating)
+        self.readouts = readouts
 
 
 def L_of(out: ControlOutput) -> float:

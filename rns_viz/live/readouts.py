@@ -6,6 +6,7 @@ from functools import cache
 
 import numpy as np
 
+from rns_viz.live.dual import compensator_sigmas, is_dual
 from rns_viz.live.records import Readouts
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector, rns_projector
@@ -19,7 +20,10 @@ def arm_reach(model: FsmsModel) -> float:
 
 
 def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:
-    """S H_bm, its smallest singular value, the RNS-rank-th singular value of J-bar and the RNS dimension."""
+    """S H_bm, its smallest singular value, the RNS-rank-th singular value of J-bar and the RNS dimension
+    (dual arms: the compensator's sigma_min(S H_bm,2) and the task arm's sigma_min(J_1) instead)."""
+    if is_dual(model):
+        return compensator_sigmas(model, theta)
     m = model.m
     H = model.mass_matrix(model.q(theta))[model.selected, m:]
     rns_dim = model.n - H.shape[0]
@@ -67,4 +71,5 @@ def compute_readouts(
         ee_error=ee_error,
         reaction=reaction,
         reaction_t=reaction_t,
+        dual=is_dual(model),
     )

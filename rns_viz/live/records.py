@@ -17,7 +17,6 @@ from rns_viz.live.recorder import Recording
 
 Level = Literal["info", "warning", "error"]
 UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)
-TARGET_SPEED = 0.5  # m/s: default speed limit of the smoothed target
 
 
 class Notice(NamedTuple):
@@ -48,7 +47,7 @@ class Settings:
         """A model's defaults (rns_viz.defaults), suppression on, no preset."""
         law = defaults_for(model).law
         gains = defaults_for(model).gains_for(law)
-        return cls(model, law, gains, True, UBAR_SPEED, TARGET_SPEED, shadow, speed, None)
+        return cls(model, law, gains, True, UBAR_SPEED, defaults_for(model).target_speed_m_s, shadow, speed, None)
 
 
 @dataclass(frozen=True)
@@ -63,6 +62,9 @@ class Readouts:
     ee_error: float = math.nan  # m: |x_ref - x_e|
     reaction: float = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1)
     reaction_t: float = math.nan  # s: start time of the step it was evaluated at
+    dual: bool = False  # a task arm and a compensating arm: sigma_hbm is S H_bm,2's, sigma_jbar J_1's
+    cancel: str | None = None  # why the compensating arm cannot cancel the reaction now (None: it does)
+    compensating: bool = True  # dual arms: the operated run's compensator cancels (the shadow's is held)
 
 
 @dataclass(frozen=True)

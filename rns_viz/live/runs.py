@@ -1,5 +1,6 @@
 """The operated run and its shadow: two simulations of one model that get the same inputs and kicks,
-with vibration suppression the other way in the shadow, so suppression on and off are compared live.
+with vibration suppression the other way in the shadow, so suppression on and off are compared live
+(a dual-arm model's shadow holds its compensating arm instead: compensation on and off).
 
 :class:`RunPair` owns both simulators, their laws and their kick schedules. Only the simulation loop
 calls it, between steps.
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.control import ControlOutput, Gains, JointSample, LawKind, TaskSample
+from rns_viz.live.dual import flip_compensation, rehold
 from rns_viz.live.guard import Bounds
 from rns_viz.live.kicks import KickSchedule
 from rns_viz.live.laws import LiveLaw, build_law
@@ -25,7 +27,7 @@ SHADOW_LOG_CAPACITY = 10  # the shadow's log is not shown
 
 @dataclass(frozen=True)
 class LawChoice:
-    """Which law the pair runs and how; the shadow gets ``not suppress``."""
+    """Which law the pair runs and how; the shadow gets ``not suppress`` (dual arms: its compensator held)."""
 
     kind: LawKind
     gains: Gains
@@ -79,16 +81,18 @@ class RunPair:
     ) -> None:
         """Live laws that follow the operator's samples (``task`` for Eq. (24); ``joint_move``: the servo)."""
         pair = tuple(
-            build_law(run.model, choice.kind, choice.gains, suppress, joint, task, joint_move)
+            build_law(run.model, choice.kind, choice.gains, suppress, joint, task, joint_move, run is self.shadow)
             for run, suppress in ((self.sim, choice.suppress), (self.shadow, not choice.suppress))
         )
         self.sim.law, self.shadow.law = pair[0].law, pair[1].law
         self._live = pair  # type: ignore[assignment]
 
     def adopt_preset_laws(self) -> LawChoice:
-        """Keep a preset's laws; the shadow's suppression is flipped. Returns what the operated run uses."""
+        """Keep a preset's laws; the shadow's suppression (dual arms: compensation) is flipped. Returns what
+        the operated run uses."""
         law = self.sim.law
         self.shadow.law.set_suppression(not law.suppress)
+        flip_compensation(law, self.shadow.law)
         self._live = None
         return LawChoice(law.kind if law.kind != "servo" else "acceleration", law.gains, law.suppress)
 
@@ -135,4 +139,5 @@ class RunPair:
         """Restart the shadow from the operated run's state, with the same pending kicks."""
         sim = self.sim
         self.shadow.reset(q0=sim.q.copy(), v0=sim.v.copy(), t0=sim.t)
+        rehold(self.shadow.law)
         self.kicks_shadow.pulses = list(self.kicks.pulses)

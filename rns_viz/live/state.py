@@ -14,6 +14,7 @@ from rns_viz.control import Gains, LawKind
 from rns_viz.defaults import defaults_for
 from rns_viz.live import commands as c
 from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
+from rns_viz.live.dual import refuse_other_laws
 from rns_viz.live.gain_explorer import GainExplorer
 from rns_viz.live.geometry import Geometry
 from rns_viz.live.guard import GUARD_EVERY, Bounds
@@ -27,10 +28,11 @@ from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Level, Notice, ReplayView, Settings, Snapshot
 from rns_viz.live.replay import apply_replay
 from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
+from rns_viz.live.settle import settled_elsewhere
 from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
-from rns_viz.scenarios import SCENARIOS
+from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
 
@@ -42,7 +44,7 @@ class LiveState:
         self.background = Background()
         self.geometry = Geometry(self.background)
         self.explorer = GainExplorer()
-        self.outputs = Outputs()
+        self.outputs = Outputs(warn=lambda title, body: self.notify(title, body, None, "warning"))
         self._gain_memory: dict[tuple[str, LawKind], Gains] = {}
         self.epoch = self.settings_version = self.target_version = 0
         self.paused = False
@@ -129,7 +131,7 @@ class LiveState:
         self._request_geometry(theta)
 
     def _adopt_preset(self, name: str, runs: RunPair) -> None:
-        self._use_model(SCENARIOS[name].model)
+        self._use_model(LIVE_SCENARIOS[name].model)
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
@@ -216,6 +218,7 @@ class LiveState:
                     self.outputs.plots.clear()
                 self.settings = replace(st, suppress=on)
             case c.SetLaw(law=law):
+                refuse_other_laws(self.model, law)
                 self._gain_memory[(st.model, st.law)] = st.gains
                 gains = self._gain_memory.get((st.model, law), defaults_for(st.model).gains_for(law))
                 self.settings = replace(st, law=law, gains=gains)
@@ -267,7 +270,7 @@ class LiveState:
             case c.LoadPreset(name=name, paused=paused):
                 self._preset_paused = paused
                 self.background.preset(self.epoch, name)
-                self.notify("Loading preset", f"{name}: {SCENARIOS[name].description}", cmd.client, "info")
+                self.notify("Loading preset", f"{name}: {LIVE_SCENARIOS[name].description}", cmd.client, "info")
             case _:
                 raise TypeError(f"unknown command {cmd!r}")
 
@@ -331,15 +334,11 @@ class LiveState:
     def _check_settled(self) -> None:
         """Once the arm rests on another level of the coupling potential (e.g. after law (15) absorbed a
         kick), re-anchor the reference there and recompute the current path / reachable set."""
-        sim, op, m = self.runs.sim, self.operator, self.runs.model.m
-        if float(np.max(np.abs(sim.v))) > 1e-3 or float(np.max(np.abs(sim.q[:m]))) > 1e-5 * self.reach_m:
-            return
-        if op is not None and (op.busy or self.settings.law == "velocity"):
-            return  # (30) pulls the arm back to theta_ref in every direction: nothing to re-anchor
-        theta = sim.q[m:].copy()
-        level = self.field.potentials(theta[None])[0]
-        reference_level = op.level if op is not None else self.geometry.shown_level
-        if reference_level is None or float(np.max(np.abs(level - reference_level))) <= self.tol:
+        st, op = self.settings, self.operator
+        theta = settled_elsewhere(
+            self.runs.sim, op, st.law, self.field, self.reach_m, self.tol, self.geometry.shown_level
+        )
+        if theta is None:
             return
         if op is not None:
             op.re_anchor(theta)

@@ -17,13 +17,18 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
-from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, SCENARIOS
+from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS
 from rns_viz.viz.live_plots import LivePlots
 
-MODEL_LABELS = {"trep": "TREP (2R on a flexible beam)", "planar3r": "planar 3R on a spring"}
+MODEL_LABELS = {
+    "trep": "TREP (2R on a flexible beam)",
+    "planar3r": "planar 3R on a spring",
+    "trep2": "TREP + compensating arm",
+}
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
 PLANAR3R_PRESETS = ("fig3", "fig4")
+DUAL_PRESETS = tuple(DUAL_SCENARIOS)  # trep2: the task arm's circle and a kick, compensator on and off
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
@@ -95,6 +100,7 @@ class GuiElements:
     gains: dict[str, viser.GuiSliderHandle]
     presets_trep: viser.GuiButtonGroupHandle
     presets_3r: viser.GuiButtonGroupHandle
+    presets_dual: viser.GuiButtonGroupHandle
     preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
@@ -145,6 +151,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
     with gui.add_folder("Paper presets"):
         presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=preset_hint(TREP_PRESETS))
         presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=preset_hint(PLANAR3R_PRESETS))
+        presets_dual = gui.add_button_group("TREP + compensator", DUAL_PRESETS, hint=preset_hint(DUAL_PRESETS))
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
@@ -199,11 +206,12 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             hint="How fast the arm moves along the path, the paper's ū in 1/(kg·m·s) (Fig. 12 uses 30); "
             "the line above turns it into joint speeds.",
         )
-    with gui.add_folder("Target (planar 3R)") as target_folder:
+    with gui.add_folder("Target (planar 3R, TREP + compensator)") as target_folder:
         gui.add_markdown(
-            "Drag the **green handle** in the scene (x and y only). The arm follows with reactionless "
-            "end-effector control, Eq. (24). Targets outside the reactionless reachable set (lilac dots) "
-            "are clamped to its nearest point."
+            "Drag the **green handle** in the scene (x and y only). Planar 3R: the arm follows with "
+            "reactionless end-effector control, Eq. (24); targets outside the reactionless reachable set "
+            "(lilac dots) are clamped to its nearest point. TREP + compensator: the task arm follows "
+            "anywhere in its workspace and the second arm cancels its reaction on the beam."
         )
         target_speed = gui.add_slider(
             "Target speed (m/s)",
@@ -230,7 +238,8 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             "Model",
             tuple(MODEL_LABELS.values()),
             initial_value=MODEL_LABELS[model],
-            hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring.",
+            hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring. "
+            "TREP + compensating arm: a second arm on the beam tip cancels the first one's reaction.",
         )
         exaggeration = gui.add_slider(
             "Deflection drawn ×",
@@ -284,6 +293,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         gains=gains,
         presets_trep=presets_trep,
         presets_3r=presets_3r,
+        presets_dual=presets_dual,
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
@@ -295,7 +305,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
 
 def preset_hint(names: tuple[str, ...]) -> str:
     """One click loads a figure's experiment; what each button is, in the paper's figure order."""
-    what = "; ".join(f"{name}: {SCENARIOS[name].description.split(': ', 1)[-1]}" for name in names)
+    what = "; ".join(f"{name}: {LIVE_SCENARIOS[name].description.split(': ', 1)[-1]}" for name in names)
     units = "Gains in 1/s, u-bar in 1/(kg m s)."
     return f"One click loads a figure's experiment (law, gains, motion, kicks, model). {what}. {units}"
 
@@ -303,4 +313,4 @@ def preset_hint(names: tuple[str, ...]) -> str:
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**{name}**: {SCENARIOS[name].description}. Reset restarts it."
+    return f"**{name}**: {LIVE_SCENARIOS[name].description}. Reset restarts it."

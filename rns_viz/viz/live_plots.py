@@ -69,6 +69,18 @@ PLOTS_CAPTION = (
     '<div style="font-size:0.75em;opacity:0.8">The last 10 s: how far the base is bent, x_b (µm); the momentum '
     "the arm's joints hand to the base, L (mN·s = g·m/s); how far the hand is from where it is sent, |e| (mm).</div>"
 )
+# (blue header, red header, note) of the peaks table: one arm (suppression) or two (compensation)
+SUPPRESSION_SIDES = (
+    "suppression on",
+    "suppression off",
+    "|e|: the operated run. Blue is always suppression on, red off; the other run is the shadow run.",
+)
+COMPENSATION_SIDES = (
+    "compensating",
+    "compensator held",
+    "|e|: the operated run. Blue (the charts' 'suppression on') is always the run whose second arm cancels "
+    "the reaction, red the one whose second arm is held still; the other run is the shadow run.",
+)
 
 
 class LivePlots:
@@ -97,6 +109,7 @@ class LivePlots:
             "millimetres (fig11-fast against fig11-joint2).",
         )
         self.mode = "linear"
+        self.sides = SUPPRESSION_SIDES  # the peaks table's headers (the app sets them per model)
         self.show_mode("linear")
 
     @property
@@ -131,7 +144,8 @@ class LivePlots:
                 "xb": (peak(xb_on) * 1e-3, peak(xb_off) * 1e-3),
                 "L": (peak(L_on), peak(L_off)),
                 "e": (e, math.nan) if arrays["suppress"][-1] > 0.5 else (math.nan, e),
-            }
+            },
+            self.sides,
         )
         if self.peaks.content != content:
             self.peaks.content = content
@@ -151,11 +165,12 @@ _ROW_HINTS = {
 }
 
 
-def peaks_html(peaks: dict[str, tuple[float, float]] | None) -> str:
+def peaks_html(peaks: dict[str, tuple[float, float]] | None, sides: tuple[str, str, str] = SUPPRESSION_SIDES) -> str:
     """The peak of every curve over the plotted window (SI values in ``data-si`` for tests and tools)."""
+    on_label, off_label, note = sides
     head = (
-        f'<tr><th style="text-align:left">peak, last 10 s</th><th style="color:{ON_COLOUR}">suppression on</th>'
-        f'<th style="color:{OFF_COLOUR}">suppression off</th></tr>'
+        f'<tr><th style="text-align:left">peak, last 10 s</th><th style="color:{ON_COLOUR}">{on_label}</th>'
+        f'<th style="color:{OFF_COLOUR}">{off_label}</th></tr>'
     )
     rows = []
     for key, label, unit in _ROWS:
@@ -165,7 +180,6 @@ def peaks_html(peaks: dict[str, tuple[float, float]] | None) -> str:
             for side, v in (("on", on), ("off", off))
         )
         rows.append(f'<tr title="{_ROW_HINTS[key]}"><td>{html.escape(label)}</td>{cells}</tr>')
-    note = "|e|: the operated run. Blue is always suppression on, red off; the other run is the shadow run."
     return (
         '<table style="font-size:0.8em;width:100%">' + head + "".join(rows) + "</table>"
         f'<div style="font-size:0.75em;opacity:0.75">{note}</div>'

@@ -10,6 +10,7 @@ from rns_viz.viz.units import si
 OK_COLOUR = "#1b7f3b"
 WARN_COLOUR = "#c77700"
 BAD_COLOUR = "#c0262d"
+SHORT_NAMES = {"trep": "TREP", "planar3r": "planar 3R", "trep2": "TREP + compensator"}
 
 
 def _badge(text: str, colour: str) -> str:
@@ -22,7 +23,7 @@ def _badge(text: str, colour: str) -> str:
 def status_html(snap: Snapshot) -> str:
     """One line: model, simulated time, real-time factor and state, with flags in colour."""
     st = snap.settings
-    model = "TREP" if st.model == "trep" else "planar 3R"
+    model = SHORT_NAMES.get(st.model, st.model)
     if snap.diverged:
         state = _badge("STOPPED", BAD_COLOUR)
     elif snap.paused:
@@ -51,6 +52,8 @@ def _value(v: float, warn: float, unit: str, digits: int = 3) -> str:
 
 def readouts_html(snap: Snapshot) -> str:
     r = snap.readouts
+    if r.dual:
+        return _table(dual_rows(snap))
     if r.n is not None:
         n = "(" + ", ".join(f"{v:+.3g}" for v in r.n) + ") kg·m"
     else:
@@ -81,8 +84,47 @@ def readouts_html(snap: Snapshot) -> str:
             "red arrow: −(H_bm θ'' + c_b), Eq. (1): the arm's push on the base",
         ),
     ]
+    return _table(rows)
+
+
+def _table(rows: list[tuple[str, str, str]]) -> str:
     body = "".join(
         f'<tr title="{hint}"><td style="padding-right:8px">{name}</td><td>{value}</td></tr>'
         for name, value, hint in rows
     )
     return f'<table style="font-size:0.85em;width:100%">{body}</table>'
+
+
+def dual_rows(snap: Snapshot) -> list[tuple[str, str, str]]:
+    """Readouts of a task arm with a compensating arm (Sec. III-B): the compensator's grip on the base,
+    whether it cancels the task arm's reaction, and the residual reaction."""
+    r = snap.readouts
+    if r.cancel is None:
+        cancel = f'<span style="color:{OK_COLOUR};font-weight:600">cancelling</span>'
+    else:
+        cancel = f'<span style="color:{BAD_COLOUR};font-weight:600">{r.cancel}</span>'
+    return [
+        (
+            "σ<sub>min</sub>(S H<sub>bm,2</sub>)",
+            _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
+            "the compensating arm's grip on the base; near 0 (its links along the beam's swing) it cannot cancel",
+        ),
+        ("compensator", cancel, "whether the second arm cancels the task arm's reaction on the base"),
+        (
+            "σ<sub>min</sub>(J<sub>1</sub>)",
+            _value(r.sigma_jbar, r.warn_jbar, "m/rad"),
+            "how freely the task arm's hand moves; near 0 it is stretched out or folded",
+        ),
+        (
+            "L = S H<sub>bm</sub>θ̇",
+            si(r.L, "N·s", 1e-9, True),
+            "total momentum both arms hand to the base (purple arrow), Eq. (8): the compensator keeps it 0",
+        ),
+        ("x<sub>b</sub>", si(float(snap.q[0]), "m", 1e-9, True), "how far the base is bent from rest"),
+        ("end-effector error", si(r.ee_error, "m", floor=1e-9), "how far the task arm's hand is from the target"),
+        (
+            "residual reaction",
+            si(r.reaction, "N", 1e-6, True),
+            "red arrow: −(H_bm θ'' + c_b), Eq. (1), of both arms: what the compensator leaves on the base",
+        ),
+    ]

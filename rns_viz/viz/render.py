@@ -16,6 +16,7 @@ import numpy as np
 import viser
 
 from rns_viz.defaults import defaults_for
+from rns_viz.live.dual import is_dual
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Snapshot
@@ -31,7 +32,9 @@ from rns_viz.viz.gui import (
     preset_description,
 )
 from rns_viz.viz.inputs import Controls
+from rns_viz.viz.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
 from rns_viz.viz.panel_text import readouts_html, status_html
+from rns_viz.viz.rank_scene import RankScene
 from rns_viz.viz.scene import FsmsScene
 from rns_viz.viz.teach_scene import TeachScene
 from rns_viz.viz.view_toggles import ViewToggles
@@ -89,7 +92,10 @@ class Renderer:
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
         self._reach = arm_reach(self.model)
         self.teach = TeachScene(self.server, self.model, self.scene)
-        self.teach.reaction_label = REACTION_LABEL
+        self.rank = RankScene(self.server, self.model, self.scene.style)
+        dual = is_dual(self.model)
+        self.teach.reaction_label = "residual reaction" if dual else REACTION_LABEL
+        self.gui.plots.sides = COMPENSATION_SIDES if dual else SUPPRESSION_SIDES
         st = self.scene.style
         self.handle = self.server.scene.add_transform_controls(
             TARGET_HANDLE,
@@ -155,6 +161,7 @@ class Renderer:
         exaggeration = float(self.controls.good(self.gui.exaggeration))
         q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
         self.teach.draw(snap, q_shadow, exaggeration, self.view)
+        self.rank.draw(self.view.on("rank"))
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
             self._draw_overlays()
@@ -188,7 +195,7 @@ class Renderer:
             with self.server.atomic():
                 self.scene.update(q, exaggeration)
                 f = snap.readouts.reaction  # N, exactly the readout's (Eq. 1); the label shows 3 digits
-                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, REACTION_LABEL)
+                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, self.teach.reaction_label)
             self.scene_updates += 1
 
     def _draw_target(self, snap: Snapshot) -> None:
@@ -313,6 +320,7 @@ class Renderer:
         joint_gains = on_path and st.law != "velocity"
         g.gains["G_p"].visible = g.gains["G_d"].visible = task_gains
         g.gains["k_p"].visible = g.gains["k_d"].visible = joint_gains
+        g.law.disabled = is_dual(self.model)  # one law for dual arms: the compensating law
 
 
 class _Seen:

@@ -6,7 +6,7 @@ from the arm's reach for any other URDF.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -65,8 +65,8 @@ class SceneStyle:
 
 def style_for(model: FsmsModel) -> SceneStyle:
     """The drawing style of a bundled model, or one scaled by the arm's reach."""
-    if model.name == "trep":
-        return SceneStyle(
+    if model.name in ("trep", "trep2"):
+        trep = SceneStyle(
             base=DoubleBeamStyle(),
             camera_position=(0.29, 0.47, 0.48),
             camera_look_at=(0.0, 0.45, -0.03),
@@ -83,6 +83,10 @@ def style_for(model: FsmsModel) -> SceneStyle:
             overlay_z=0.024,
             base_label=(-0.065, -0.01, 0.0),
         )
+        if model.name == "trep":
+            return trep
+        # trep2: TREP's beam and arm; its compensating arm hangs 0.09 m below the arm plane
+        return replace(trep, grid_z=-0.17, camera_position=(0.24, 0.84, 0.1), camera_look_at=(0.0, 0.42, -0.07))
     if model.name == "planar3r":
         return SceneStyle(
             base=CartSpringStyle(),

@@ -89,14 +89,18 @@ class TeachScene:
     def draw(self, snap: Snapshot, q_shadow: np.ndarray | None, exaggeration: float, view: ViewToggles) -> None:
         """Ghost (``q_shadow`` as drawn, or None), L and n for the snapshot; hidden parts cost nothing."""
         self._apply_toggles(snap, view)
-        off = "OFF" if snap.settings.suppress else "ON"
-        self.ghost.update(q_shadow if view.on("ghost") else None, exaggeration, f"shadow run: suppression {off}")
+        self.ghost.update(q_shadow if view.on("ghost") else None, exaggeration, self._shadow_label(snap))
         self._draw_coupling(snap.readouts.L if view.on("coupling") else None)
         theta = snap.q[self.model.m :]
         self._draw_null(theta if view.on("null_vector") and self.one_d and np.all(np.isfinite(theta)) else None)
         want = self._has_path and view.on("path_arrows")
         if self.path_arrows.visible != want:
             self.path_arrows.visible = want
+
+    def _shadow_label(self, snap: Snapshot) -> str:
+        if snap.readouts.dual:
+            return f"shadow run: compensator {'held' if snap.readouts.compensating else 'cancelling'}"
+        return f"shadow run: suppression {'OFF' if snap.settings.suppress else 'ON'}"
 
     def _apply_toggles(self, snap: Snapshot, view: ViewToggles) -> None:
         """The scene's own drawings that have a checkbox: reaction arrow, trail, reachable set."""

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import viser
 
+from rns_viz.live.rank_view import RANK_HINT
 from rns_viz.viz.connections import Connections
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
@@ -56,6 +57,12 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "Lilac dots: where the 3R's hand can go without ever pushing the base. The region ends at fold "
         "curves, where the arm can no longer move the hand outward without moving its centre of mass "
         "along the spring (J-bar loses rank).",
+    ),
+    (
+        "rank",
+        "Rank loss of H_bm (TREP, 3R)",
+        False,
+        "Amber poses (Sec. III-B, the fourth case). " + RANK_HINT,
     ),
 )
 
