@@ -6,9 +6,9 @@ For each model a session without its loop thread (``realtime=False``) runs the s
 simulation (a kick, TREP also moving along its path) with the recorder on and, as the baseline in
 the same run, with it switched off; rounds alternate so a busy machine slows both alike. Printed:
 the median CPU time (of the stepping thread) per 1 ms step of both, their ratio, the cost
-per step in µs and as % of one core at real time, and the append alone timed directly; then the ring buffer's size for 60 s (target
-<= 50 MB), the bytes of one row, and the memory a 60 s replay adds (its immutable copy) and a
-CSV / player export adds (the end-effector table).
+per step in µs and as % of one core at real time, and the append alone timed directly; then the
+ring buffer's size for 60 s (target <= 50 MB), the bytes of one row, and the memory a 60 s
+replay adds (its immutable copy) and a CSV / player export adds (the end-effector table).
 """
 
 from __future__ import annotations
