@@ -6,9 +6,9 @@ For each model a session without its loop thread (``realtime=False``) runs the s
 simulation (a kick, TREP also moving along its path) with the recorder on and, as the baseline in
 the same run, with it switched off; rounds alternate so a busy machine slows both alike. Printed:
 the median CPU time (of the stepping thread) per 1 ms step of both, their ratio, the cost
-per step in µs and as % of one core at real time; then the ring buffer's size for 60 s (target
-<= 50 MB), the bytes of one row, and the memory a 60 s replay adds (its immutable copy) and a
-CSV / player export adds (the end-effector table).
+per step in µs and as % of one core at real time, and the append alone timed directly; then the
+ring buffer's size for 60 s (target <= 50 MB), the bytes of one row, and the memory a 60 s
+replay adds (its immutable copy) and a CSV / player export adds (the end-effector table).
 """
 
 from __future__ import annotations
@@ -47,6 +47,16 @@ def step_time(model: str, seconds: float, record: bool) -> float:
         s.stop()
 
 
+def append_time(s: Session, calls: int = 20000) -> float:
+    """CPU seconds of one ``Recorder.append`` (both runs' newest rows into the ring), the direct figure:
+    a whole-step comparison on a busy machine varies by more than this."""
+    rec, runs = s.state.outputs.recorder, s.state.runs
+    t0 = time.thread_time()
+    for _ in range(calls):
+        rec.append(runs, True, 0.0, True)
+    return (time.thread_time() - t0) / calls
+
+
 def memory(model: str) -> None:
     s = Session(model, realtime=False)
     try:
@@ -54,6 +64,8 @@ def memory(model: str) -> None:
         s.kick(KICKS[model])
         s.advance(60.5)
         rec: Recorder = s.state.outputs.recorder
+        one = append_time(s)
+        print(f"  Recorder.append alone  {one * 1e6:7.1f} µs per step = {one * 1e5:.2f} % of one core at real time")
         print(
             f"  ring buffer for 60 s   {rec.nbytes() / 1e6:6.1f} MB (target <= 50); "
             f"{len(rec.columns)} columns x 8 B = {8 * len(rec.columns)} B per 1 ms step"

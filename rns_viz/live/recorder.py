@@ -6,7 +6,7 @@ preallocated ring buffer: per step, the operated run's step-log row (t, x_b, x_b
 base force, L, the distances to singularity and the law's references θ_ref / x_ref, exactly the
 floats of the simulation log), the shadow run's state, L and τ at the same t, the arm's reaction on
 the base (Eq. 1) as the readout showed it and whether suppression was on. Always on because it costs
-one row copy per step (a few µs, under 1 % of the loop) and 60 s of TREP fill 16 MB (3R: 19 MB);
+one row copy per step (about 2 µs: 0.2 % of one core) and 60 s of TREP fill 15 MB (3R: 18 MB);
 it restarts with the run (reset, model switch, preset load), so a recording never spans two systems.
 
 :meth:`Recorder.take` copies the newest N seconds into a :class:`Recording`: read-only arrays that any
