@@ -66,6 +66,8 @@ def press(name: str, *args: object) -> Callable[[Session], None]:
 TREP_CASES = [
     (1, kick_then(3.5), True),
     (1, wait(3.5), False),  # no kick: nothing to see
+    (1, kick_then(3.5, peak=0.05), False),  # too small to see (0.3 mm): "kick harder"
+    (1, then(press("set_suppression", True), kick_then(3.5)), False),  # suppression damps it: not undamped
     (2, then(press("point_to_point"), wait(4.0)), True),
     (2, then(press("play_slow"), wait(6.0)), False),  # reactionless: the base stays still
     (3, then(press("play_slow"), wait(6.0)), True),
@@ -137,3 +139,19 @@ def test_bad_lesson_numbers_are_refused() -> None:
                 s.start_lesson(model, number)  # type: ignore[arg-type]
     finally:
         s.stop()
+
+
+@pytest.mark.parametrize(
+    ("student", "advice"),
+    [
+        (kick_then(3.5, peak=0.05), "kick harder"),
+        (then(press("set_suppression", True), kick_then(3.5)), "Untick *Vibration suppression*"),
+    ],
+)
+def test_lesson_1_says_why_a_kick_does_not_count(
+    trep_session: Session, student: Callable[[Session], None], advice: str
+) -> None:
+    done, progress = run_lesson(trep_session, "trep", 1, student)
+    trep_session.stop_lesson()
+    trep_session.reset()
+    assert not done and advice in progress, progress

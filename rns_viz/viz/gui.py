@@ -117,7 +117,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
     status = gui.add_html("")
     gui.add_markdown(
         "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
-        "drag the **green handle**."
+        "drag the handle labelled **drag me** in the scene (its arrows or its square)."
     )
     with gui.add_folder("Operate"):
         kick = gui.add_button(
@@ -164,8 +164,8 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         readouts = gui.add_html("")
     with gui.add_folder("Reactionless path (TREP)") as path_folder:
         gui.add_markdown(
-            "Drag the **green handle** in the scene: the end effector moves along its current reactionless "
-            "path (red) to the point nearest the handle. Or scrub the path position."
+            "Drag the handle labelled **drag me** in the scene: the end effector moves along its current "
+            "reactionless path (red) to the point nearest the handle. Or scrub the path position."
         )
         sigma = gui.add_slider(
             "Path ∫ū dt (1/(kg·m))",
@@ -208,7 +208,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         )
     with gui.add_folder("Target (planar 3R, TREP + compensator)") as target_folder:
         gui.add_markdown(
-            "Drag the **green handle** in the scene (x and y only). Planar 3R: the arm follows with "
+            "Drag the handle labelled **drag me** (x and y only). Planar 3R: the arm follows with "
             "reactionless end-effector control, Eq. (24); targets outside the reactionless reachable set "
             "(lilac dots) are clamped to its nearest point. TREP + compensator: the task arm follows "
             "anywhere in its workspace and the second arm cancels its reaction on the beam."
