@@ -21,6 +21,7 @@ import viser
 from rns_viz.live.operator_lock import OperatorLock
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
+from rns_viz.viz.client_pace import ClientPace
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gui import GuiElements, make_gui
 from rns_viz.viz.inputs import Controls
@@ -38,7 +39,9 @@ IDLE_RESTART_S = 60.0  # s of simulated time: a session older than this restarts
 class RnsApp:
     """The GUI and scene of one session on one viser server."""
 
-    def __init__(self, server: viser.ViserServer, session: Session, password: str | None = None) -> None:
+    def __init__(
+        self, server: viser.ViserServer, session: Session, password: str | None = None, pace: bool = True
+    ) -> None:
         self.server = server
         self.session = session
         self.password = password
@@ -52,6 +55,7 @@ class RnsApp:
         self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
         self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
         self.recorder = SceneRecorder(server, self.connections)
+        self.pace = ClientPace(server, enabled=pace)  # each page gets updates at the rate it can draw
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
@@ -103,6 +107,7 @@ class RnsApp:
         return self
 
     def stop(self) -> None:
+        self.pace.stop()
         self.renderer.stop()
         self.session.stop()
         self.server.stop()
@@ -111,6 +116,7 @@ class RnsApp:
         """Register the client; the first visitor of an unwatched session that ran on for a while gets
         it from the start (not "t = 4365 s" of a kick nobody saw)."""
         self.connections.client_joined(client)
+        self.pace.client_joined(client)
         if self.connections.client_count() == 1 and self.session.snapshot().t > IDLE_RESTART_S:
             self.session.reset()
 
@@ -118,6 +124,7 @@ class RnsApp:
         """End the client's drag while it still counts as the operator, then pass control on."""
         self.controls.client_left(client.client_id)
         self.connections.client_left(client.client_id)
+        self.pace.client_left(client.client_id)
 
 
 def start_app(
@@ -128,14 +135,16 @@ def start_app(
     realtime: bool = True,
     verbose: bool = True,
     lesson: int | None = None,
+    pace: bool = True,
 ) -> RnsApp:
     """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
-    ``lesson``: start at that lesson (1-based) of the model."""
+    ``lesson``: start at that lesson (1-based) of the model; ``pace=False``: every page gets every
+    update however slowly it draws (for comparisons; see :mod:`rns_viz.viz.client_pace`)."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password).start()
+        app = RnsApp(server, session, password, pace=pace).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:

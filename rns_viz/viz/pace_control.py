@@ -1,0 +1,81 @@
+"""How often one browser gets the scene and the plots: a rate that follows the page's answer time.
+
+Pure logic (no viser, no clock of its own: every call is given ``now`` in seconds), driven by
+:mod:`rns_viz.viz.client_pace`. The server asks each page a small question (a ping) and times the
+answer. A page answers after it has applied everything sent before the question, so the answer
+time is how far that page is behind. The rule is additive-increase / multiplicative-decrease:
+
+- answer slower than ``SLOW_ANSWER_S``: the page is falling behind, halve its rate;
+- answer faster than ``FAST_ANSWER_S``: it keeps up, raise the rate by a quarter (plus 1 Hz) up to
+  the full rate;
+- in between: keep the rate;
+- a question unanswered for ``HOLD_S``: the page is frozen or hidden or very busy; send it
+  nothing until it answers (then it gets the latest state at once, never the backlog).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+FULL_HZ = 60.0  # the render thread's own frame rate: a page at this rate is not paced at all
+MIN_HZ = 1.0  # a page that answers at all gets at least this
+SLOW_ANSWER_S = 0.35  # s: an answer slower than this halves the rate ...
+FAST_ANSWER_S = 0.15  # ... one faster than this raises it
+RAISE_FACTOR, RAISE_STEP_HZ, LOWER_FACTOR = 1.25, 1.0, 0.5
+HOLD_S = 1.0  # s without an answer: send nothing more until it comes
+NOTICE_BELOW_HZ = 45.0  # the page is told it is slowed below this rate, and until it is back at full
+
+
+@dataclass
+class PaceController:
+    """The rate of one page; ``ping_sent`` / ``ping_answered`` feed it, ``wait_s`` gates the sending."""
+
+    hz: float = FULL_HZ
+    asked_at: float | None = None  # s, when the oldest unanswered question was sent
+    last_answer_s: float = 0.0
+    noticed: bool = False  # whether the page is currently told that it is slowed
+
+    def ping_sent(self, now: float) -> None:
+        """A question went out (the oldest unanswered one is what counts)."""
+        if self.asked_at is None:
+            self.asked_at = now
+
+    def ping_answered(self, now: float) -> float:
+        """The page answered: adapt the rate to the answer time (s), which is returned."""
+        answer_s = 0.0 if self.asked_at is None else max(0.0, now - self.asked_at)
+        self.asked_at = None
+        self.last_answer_s = answer_s
+        if answer_s > SLOW_ANSWER_S:
+            self.hz = max(MIN_HZ, self.hz * LOWER_FACTOR)
+        elif answer_s < FAST_ANSWER_S:
+            self.hz = min(FULL_HZ, self.hz * RAISE_FACTOR + RAISE_STEP_HZ)
+        return answer_s
+
+    def held(self, now: float) -> bool:
+        """True while a question has been unanswered for HOLD_S or longer."""
+        return self.asked_at is not None and now - self.asked_at >= HOLD_S
+
+    def interval_s(self) -> float:
+        """Least time between two windows sent to the page (0: not paced)."""
+        return 0.0 if self.hz >= FULL_HZ else 1.0 / self.hz
+
+    def wait_s(self, now: float, since_last_send_s: float) -> float:
+        """How long to wait before sending the page its next window (0: send now). While held, the
+        question is asked again later, so a short wait that is checked again."""
+        if self.held(now):
+            return math.inf
+        return max(0.0, self.interval_s() - since_last_send_s)
+
+    def shown_hz(self) -> int:
+        """The rate the notice states (whole Hz)."""
+        return max(1, round(self.hz))
+
+    def update_notice(self, now: float) -> bool:
+        """Whether the page should show the slowed-display notice now (with hysteresis: shown below
+        NOTICE_BELOW_HZ or while held, hidden again only at the full rate)."""
+        if self.held(now) or self.hz < NOTICE_BELOW_HZ:
+            self.noticed = True
+        elif self.hz >= FULL_HZ:
+            self.noticed = False
+        return self.noticed
