@@ -24,8 +24,8 @@ if viser changes it the app warns and runs unpaced. The per-client stream (notif
 operator panel, the questions themselves) and everything the browser sends (buttons, drags,
 the operator lock) are never delayed. A fast client's stream is not touched.
 
-The page is told: a notification "Display slowed to N Hz to keep up" while it is paced below
-NOTICE_BELOW_HZ, removed when it is back at the full rate.
+The page is told: a notification "Display slowed to N Hz to keep up" once it is paced below
+NOTICE_BELOW_HZ (or held), removed when it is back at NOTICE_GONE_HZ or more.
 """
 
 from __future__ import annotations

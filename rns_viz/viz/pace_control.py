@@ -6,8 +6,8 @@ answer. A page answers after it has applied everything sent before the question,
 time is how far that page is behind. The rule is additive-increase / multiplicative-decrease:
 
 - answer slower than ``SLOW_ANSWER_S``: the page is falling behind, halve its rate;
-- answer faster than ``FAST_ANSWER_S``: it keeps up, raise the rate by a quarter (plus 1 Hz) up to
-  the full rate;
+- answer faster than ``FAST_ANSWER_S``: it keeps up, raise the rate by half (plus 2 Hz) up to the
+  full rate (from 1 Hz back to full in 7 answers, about 2 s);
 - in between: keep the rate;
 - a question unanswered for ``HOLD_S``: the page is frozen or hidden or very busy; send it
   nothing until it answers (then it gets the latest state at once, never the backlog).
@@ -20,11 +20,12 @@ from dataclasses import dataclass
 
 FULL_HZ = 60.0  # the render thread's own frame rate: a page at this rate is not paced at all
 MIN_HZ = 1.0  # a page that answers at all gets at least this
-SLOW_ANSWER_S = 0.35  # s: an answer slower than this halves the rate ...
-FAST_ANSWER_S = 0.15  # ... one faster than this raises it
-RAISE_FACTOR, RAISE_STEP_HZ, LOWER_FACTOR = 1.25, 1.0, 0.5
+SLOW_ANSWER_S = 0.5  # s: an answer slower than this halves the rate (the page shows a state this old) ...
+FAST_ANSWER_S = 0.25  # ... one faster than this raises it
+RAISE_FACTOR, RAISE_STEP_HZ, LOWER_FACTOR = 1.5, 2.0, 0.5
 HOLD_S = 1.0  # s without an answer: send nothing more until it comes
-NOTICE_BELOW_HZ = 45.0  # the page is told it is slowed below this rate, and until it is back at full
+NOTICE_BELOW_HZ = 30.0  # the page is told it is slowed below this rate (or while held) ...
+NOTICE_GONE_HZ = 45.0  # ... until it is back at this rate (hysteresis: no flicker around one value)
 
 
 @dataclass
@@ -73,9 +74,9 @@ class PaceController:
 
     def update_notice(self, now: float) -> bool:
         """Whether the page should show the slowed-display notice now (with hysteresis: shown below
-        NOTICE_BELOW_HZ or while held, hidden again only at the full rate)."""
+        NOTICE_BELOW_HZ or while held, hidden again from NOTICE_GONE_HZ on)."""
         if self.held(now) or self.hz < NOTICE_BELOW_HZ:
             self.noticed = True
-        elif self.hz >= FULL_HZ:
+        elif self.hz >= NOTICE_GONE_HZ:
             self.noticed = False
         return self.noticed
