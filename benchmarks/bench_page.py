@@ -66,6 +66,9 @@ def serve(pace: bool) -> None:
             break
         if command == "cyclic":
             s.cyclic(True)
+        if command.startswith(("hide:", "show:")):
+            for handle in drawing_group(app, command[5:]):
+                handle.visible = command.startswith("show:")
         clients = sorted(app.server.get_clients())
         stats = {
             "wall": time.perf_counter(),
@@ -76,6 +79,31 @@ def serve(pace: bool) -> None:
         }
         print(json.dumps(stats), file=out, flush=True)
     app.stop()
+
+
+# What the page draws, in groups that can be hidden one at a time to see what a frame costs.
+COST_GROUPS = ("paths", "ghost", "labels", "grid", "beam", "robot", "arrows", "reach+trail", "plots", "all 3-D")
+
+
+def drawing_group(app: Any, name: str) -> list[Any]:
+    """Handles of one group of COST_GROUPS (scene nodes by name or kind; the plots' charts)."""
+    if name == "plots":
+        return [c for charts in app.gui.plots.charts.values() for c in charts.values() if c.visible] + [
+            app.gui.plots.error
+        ]
+    nodes = app.server.scene._handle_from_node_name  # viser 1.1.1: name -> handle
+    kinds = {"labels": "LabelHandle", "robot": "GlbHandle", "arrows": "ArrowsHandle"}
+    names = {
+        "paths": ("/base/paths", "/base/path_arrows"),
+        "ghost": ("/ghost",),
+        "grid": ("/grid",),
+        "beam": ("/beam/edges", "/beam/plates"),
+        "reach+trail": ("/base/reachable", "/base/reach_outline", "/base/trail"),
+        "all 3-D": ("/base", "/beam", "/ghost", "/grid", "/gain_map"),
+    }
+    if name in kinds:
+        return [h for h in nodes.values() if type(h).__name__ == kinds[name]]
+    return [nodes[n] for n in names[name] if n in nodes]
 
 
 class App:
@@ -145,8 +173,8 @@ HIDE_JS = """(hidden) => {
 }"""
 
 
-def chromium_rss_mb() -> float:
-    """Resident memory of every chromium process started by this benchmark (MB)."""
+def _descendants() -> list[int]:
+    """Process ids of everything this benchmark started (browsers, the Playwright driver, the app)."""
     children: dict[int, list[int]] = {}
     for entry in os.listdir("/proc"):
         if entry.isdigit():
@@ -155,10 +183,18 @@ def chromium_rss_mb() -> float:
             except (OSError, IndexError, ValueError):
                 continue
             children.setdefault(ppid, []).append(int(entry))
-    total, todo = 0.0, [os.getpid()]
+    found, todo = [], list(children.get(os.getpid(), []))
     while todo:
         pid = todo.pop()
+        found.append(pid)
         todo += children.get(pid, [])
+    return found
+
+
+def chromium_rss_mb() -> float:
+    """Resident memory of every chromium process started by this benchmark (MB)."""
+    total = 0.0
+    for pid in _descendants():
         try:
             if "chrom" in Path(f"/proc/{pid}/comm").read_text():
                 for line in Path(f"/proc/{pid}/status").read_text().splitlines():
@@ -167,6 +203,23 @@ def chromium_rss_mb() -> float:
         except OSError:
             continue
     return total
+
+
+def chromium_cpu_s() -> dict[str, float]:
+    """CPU seconds used so far by this benchmark's chromium processes, by kind (renderer, gpu, other)."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    out = {"renderer": 0.0, "gpu": 0.0, "other": 0.0}
+    for pid in _descendants():
+        try:
+            if "chrom" not in Path(f"/proc/{pid}/comm").read_text():
+                continue
+            cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        kind = "renderer" if b"--type=renderer" in cmd else "gpu" if b"--type=gpu-process" in cmd else "other"
+        out[kind] += (int(fields[11]) + int(fields[12])) / ticks
+    return out
 
 
 def kick_to_visible(page: Any, app: App, timeout: float = 120.0) -> float:
@@ -227,17 +280,22 @@ def scenario_one_page(pace: bool, minutes: float) -> dict[str, Any]:
             time.sleep(3.0)
             delays: list[float] = []
             start = page_figures(page, app)
+            cpu0, wall0 = chromium_cpu_s(), time.monotonic()
             t_end = time.monotonic() + 60.0 * minutes
             while time.monotonic() < t_end:
                 t0 = time.monotonic()
                 delays.append(kick_to_visible(page, app))
                 time.sleep(max(0.0, KICK_EVERY_S - (time.monotonic() - t0)))
+            cpu1, wall1 = chromium_cpu_s(), time.monotonic()
             end = page_figures(page, app)
             browser.close()
     finally:
         app.close()
     k = max(1, min(3, len(delays) // 3))
-    return {"start": start, "end": end, "kick_start": delays[:k], "kick_end": delays[-k:], "kicks": len(delays)}
+    cpu = {kind: 100.0 * (cpu1[kind] - cpu0[kind]) / (wall1 - wall0) for kind in cpu0}
+    return {"start": start, "end": end, "kick_start": delays[:k], "kick_end": delays[-k:], "kicks": len(delays)} | {
+        "cpu": cpu
+    }
 
 
 def scenario_crowd(pace: bool, seconds: float) -> dict[str, Any]:
@@ -272,6 +330,41 @@ def scenario_crowd(pace: bool, seconds: float) -> dict[str, Any]:
         "page_pace_hz": figures["pace_hz"],
         "page_raf_hz": figures["raf_hz"],
     }
+
+
+def scenario_cost(seconds: float) -> list[tuple[str, dict[str, float], dict[str, float]]]:
+    """Per group of COST_GROUPS: the page's frames and chromium's CPU per frame with everything drawn
+    and with that group hidden (measured back to back; the ratio is what the group costs)."""
+    from playwright.sync_api import sync_playwright
+
+    app = App(pace=False)  # every frame sent: what drawing costs, not what pacing saves
+
+    def measure(page: Any) -> dict[str, float]:
+        cpu0 = chromium_cpu_s()
+        raf_hz = page.evaluate(RAF_JS, int(1000 * seconds))
+        cpu1 = chromium_cpu_s()
+        frames = max(1.0, raf_hz * seconds)
+        per = {k: 1e3 * (cpu1[k] - cpu0[k]) / frames for k in cpu0}
+        return {"raf_hz": raf_hz, "renderer_ms": per["renderer"], "gpu_ms": per["gpu"]}
+
+    rows = []
+    try:
+        with sync_playwright() as pw:
+            browser, page = open_page(pw, app.port)
+            app.ask("cyclic")
+            time.sleep(8.0)  # the path family is computed and drawn
+            for name in COST_GROUPS:
+                with_it = measure(page)
+                app.ask(f"hide:{name}")
+                time.sleep(1.0)
+                without = measure(page)
+                app.ask(f"show:{name}")
+                time.sleep(1.0)
+                rows.append((name, with_it, without))
+            browser.close()
+    finally:
+        app.close()
+    return rows
 
 
 def scenario_hidden(pace: bool, minutes: float) -> dict[str, Any]:
@@ -325,7 +418,7 @@ def main() -> None:
     parser.add_argument("--minutes", type=float, default=5.0, help="minutes of the one-page run (each mode)")
     parser.add_argument("--crowd-seconds", type=float, default=60.0, help="seconds of the page + 3 clients run")
     parser.add_argument("--hidden-minutes", type=float, default=2.0, help="minutes the tab stays hidden")
-    parser.add_argument("--only", choices=("page", "crowd", "hidden"), help="run one scenario")
+    parser.add_argument("--only", choices=("page", "crowd", "hidden", "cost"), help="run one scenario")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--pace", action=argparse.BooleanOptionalAction, default=True, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -347,7 +440,10 @@ def main() -> None:
             row(f"page script delay at the {when}", a["script_s"], b["script_s"], "s")
             row(f"chromium RSS at the {when}", a["rss_mb"], b["rss_mb"], "MB")
             row(f"page JS heap at the {when}", a["heap_mb"], b["heap_mb"], "MB")
-            row(f"page answer time / rate at the {when} (paced)", a["answer_s"], a["pace_hz"], "s/Hz")
+            row(f"page answer time at the {when} (paced only)", a["answer_s"], float("nan"), "s")
+            row(f"page rate chosen at the {when} (paced only)", a["pace_hz"], float("nan"), "Hz")
+        for kind in ("renderer", "gpu"):
+            row(f"chromium {kind} CPU over the run", on["cpu"][kind], off["cpu"][kind], "%", "of one core")
     if args.only in (None, "crowd"):
         runs = {p: scenario_crowd(p, args.crowd_seconds) for p in (True, False)}
         on, off = runs[True], runs[False]
@@ -358,6 +454,16 @@ def main() -> None:
         row("scene Hz at the fast clients (slowest)", min(on["fast_hz"]), min(off["fast_hz"]), "Hz", "target >= 30")
         row("page rate chosen by the server", on["page_pace_hz"], off["page_pace_hz"], "Hz")
         row("page rAF rate", on["page_raf_hz"], off["page_raf_hz"], "Hz")
+    if args.only in (None, "cost"):
+        rows = scenario_cost(4.0)
+        print(f"\n== what a frame costs: each group hidden in turn (unpaced, cyclic motion)  [{load()}]")
+        head = ("group", "rAF Hz with / without", "renderer CPU ms/frame", "GPU-process ms/frame")
+        print(f"  {head[0]:<12} {head[1]:>22} {head[2]:>24} {head[3]:>22}")
+        for name, a, b in rows:
+            print(
+                f"  {name:<12} {a['raf_hz']:>10.1f} / {b['raf_hz']:<9.1f} {a['renderer_ms']:>11.1f} / "
+                f"{b['renderer_ms']:<10.1f} {a['gpu_ms']:>10.1f} / {b['gpu_ms']:<9.1f}"
+            )
     if args.only in (None, "hidden"):
         runs = {p: scenario_hidden(p, args.hidden_minutes) for p in (True, False)}
         on, off = runs[True], runs[False]
