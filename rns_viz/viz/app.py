@@ -1,9 +1,10 @@
 """The live app: a viser server showing a :class:`~rns_viz.live.session.Session`.
 
-Three parts, one concern each: :class:`~rns_viz.viz.inputs.Controls` turns GUI input into the
+Four parts, one concern each: :class:`~rns_viz.viz.inputs.Controls` turns GUI input into the
 session's command methods; :class:`~rns_viz.viz.connections.Connections` holds the clients, the
 operator lock and the password; :class:`~rns_viz.viz.render.Renderer` runs the render thread that
-sends the session's snapshots, plots, text, overlays and notices to the browsers.
+sends the session's snapshots, plots, text, overlays and notices to the browsers;
+:class:`~rns_viz.viz.client_pace.ClientPace` paces what each browser receives to what it can draw.
 
     serve()                      # TREP on http://127.0.0.1:8080, blocking
     app = start_app(port=0)      # non-blocking; app.port, app.session, app.gui; app.stop()
