@@ -3,15 +3,18 @@ the app with protocol-level clients that answer the server's questions late or n
 
 from __future__ import annotations
 
+import asyncio
 import itertools
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import AsyncGenerator, Iterator, Sequence
+from typing import Any
 
 import numpy as np
 import pytest
 
 from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.client_pace import _paced
 from rns_viz.viz.pace_control import (
     FAST_ANSWER_S,
     FULL_HZ,
@@ -86,6 +89,28 @@ def test_an_unanswered_question_holds_the_stream_until_it_is_answered() -> None:
     c.ping_sent(11.5)  # asked again: the oldest question still counts
     assert c.ping_answered(130.0) == pytest.approx(120.0)  # a tab frozen for two minutes
     assert not c.held(130.0) and c.hz == FULL_HZ / 2
+
+
+# ---------------------------------------------------------------- the gate on one client's windows
+def test_the_gate_is_asked_before_each_window_but_not_inside_a_split_update() -> None:
+    sizes = [3, 128, 128, 5, 4]  # a small update, one split over three windows, another small one
+    events: list[str] = []
+
+    async def windows() -> AsyncGenerator[Sequence[Any], None]:
+        for n in sizes:
+            yield list(range(n))
+
+    def wait_s(client: int, since_last_send_s: float) -> float:
+        assert client == 7 and since_last_send_s >= 0.0
+        events.append("gate")
+        return 0.0
+
+    async def take() -> None:
+        async for window in _paced(windows(), 7, wait_s, max_window=128):
+            events.append(str(len(window)))
+
+    asyncio.run(take())
+    assert events == ["gate", "3", "gate", "128", "128", "5", "gate", "4", "gate"]  # (the last: before the end)
 
 
 # ---------------------------------------------------------------- the app, protocol-level clients

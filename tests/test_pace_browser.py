@@ -47,16 +47,23 @@ def paced_client(app: RnsApp) -> int:
 
 
 def record_kicks(s: Session) -> list[float]:
-    """Peaks of the kicks the session is asked for from now on (the GUI callback's call, passed on)."""
-    peaks: list[float] = []
+    """Simulated times (s) at which the session is asked for a kick from now on (the GUI callback's
+    call, passed on)."""
+    times: list[float] = []
     kick = s.kick
 
     def recorded(peak: float, client: int | None = None) -> None:
-        peaks.append(peak)
+        times.append(s.snapshot().t)
         kick(peak, client)
 
     s.kick = recorded  # type: ignore[method-assign]
-    return peaks
+    return times
+
+
+def shown_time(page: Page) -> float:
+    """The simulated time the page's status line shows (s), -1 before it shows one."""
+    t = page.evaluate(SHOWN_TIME_JS)
+    return -1.0 if t is None else float(t)
 
 
 def notice_shown(page: Page) -> bool:
@@ -74,10 +81,12 @@ def test_a_throttled_page_is_slowed_told_so_still_operates_and_recovers(trep_app
         wait_until(lambda: app.pace.state(client)["notice"], SLOW_S, "the server to see the page fall behind")
         wait_until(lambda: notice_shown(page), SLOW_S, "the page to show the slowed-display notice", poll=1.0)
 
-        # The slowed page still operates the app: its Kick reaches the simulation.
+        # The slowed page still operates the app: its Kick reaches the simulation, and the page goes on
+        # to show the state after it.
         kicks = record_kicks(s)
         page.get_by_role("button", name="Kick the base").click(timeout=SLOW_S * 1000)
         wait_until(lambda: kicks, SLOW_S, "the slowed page's kick")
+        wait_until(lambda: shown_time(page) >= kicks[0], SLOW_S, "the slowed page to show the kick's time", poll=1.0)
 
         # Unthrottled and with less to draw, the page catches up: full rate again, notice gone.
         cdp.send("Emulation.setCPUThrottlingRate", {"rate": 1})
@@ -102,7 +111,7 @@ def test_a_hidden_frozen_tab_answers_once_shown_and_shows_the_current_state(trep
         cdp.send("Debugger.disable")
         page.evaluate(HIDE_JS, False)
         shown_at = s.snapshot().t
-        wait_until(lambda: (page.evaluate(SHOWN_TIME_JS) or -1.0) >= shown_at, SLOW_S, "the page to show the present")
+        wait_until(lambda: shown_time(page) >= shown_at, SLOW_S, "the page to show the present")
         wait_until(lambda: not app.pace.state(client)["held"], SLOW_S, "the page's answer")
         kicks = record_kicks(s)
         page.get_by_role("button", name="Kick the base").click(timeout=SLOW_S * 1000)

@@ -171,27 +171,33 @@ def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float
         return False
 
     def window_generator(client_id: int, backlog_done_message: Any = None) -> AsyncGenerator[Sequence[Any], None]:
-        return _paced(original(client_id, backlog_done_message=backlog_done_message), client_id, wait_s)
+        windows = original(client_id, backlog_done_message=backlog_done_message)
+        return _paced(windows, client_id, wait_s, buffer.max_window_size)
 
     buffer.window_generator = window_generator
     return True
 
 
 async def _paced(
-    windows: AsyncGenerator[Sequence[Any], None], client_id: int, wait_s: Callable[[int, float], float]
+    windows: AsyncGenerator[Sequence[Any], None],
+    client_id: int,
+    wait_s: Callable[[int, float], float],
+    max_window: int,
 ) -> AsyncGenerator[Sequence[Any], None]:
     """viser's windows for one client, each taken only once the gate opens. While this waits, viser's
-    buffer keeps only the newest message per node and property, so the next window is the latest state."""
-    last_sent = 0.0  # s (monotonic)
+    buffer keeps only the newest message per node and property, so the next window is the latest state.
+    A full window (viser splits a large update into windows of ``max_window`` messages) is followed
+    at once by the rest of that update, so a page never waits an interval on half a picture."""
+    last_sent, window_size = 0.0, 0  # s (monotonic), messages
     try:
         while True:
-            while (wait := wait_s(client_id, time.monotonic() - last_sent)) > 0.0:
+            while window_size < max_window and (wait := wait_s(client_id, time.monotonic() - last_sent)) > 0.0:
                 await asyncio.sleep(min(wait, GATE_POLL_S))
             try:
                 window = await windows.__anext__()
             except StopAsyncIteration:
                 return
-            last_sent = time.monotonic()
+            last_sent, window_size = time.monotonic(), len(window)
             yield window
     finally:
         await windows.aclose()
