@@ -75,9 +75,12 @@ def serve(model: str) -> None:
 
 # ---------------------------------------------------------------- client side
 class Server:
-    def __init__(self, model: str) -> None:
+    """The app in a child process that prints its handles as JSON, then one JSON line per command.
+    ``command``: another child (bench_page.py's) instead of this file's ``--serve``."""
+
+    def __init__(self, model: str, command: list[str] | None = None) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, __file__, "--serve", "--model", model],
+            command or [sys.executable, __file__, "--serve", "--model", model],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -92,11 +95,14 @@ class Server:
             raise RuntimeError("the app process ended early")
         return line
 
-    def stats(self) -> dict[str, Any]:
+    def ask(self, command: str = "stats") -> dict[str, Any]:
         assert self.proc.stdin is not None
-        self.proc.stdin.write("stats\n")
+        self.proc.stdin.write(command + "\n")
         self.proc.stdin.flush()
         return json.loads(self._line())
+
+    def stats(self) -> dict[str, Any]:
+        return self.ask("stats")
 
     def close(self) -> None:
         try:

@@ -34,11 +34,14 @@ import statistics
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # tests/ holds the browser and websocket helpers
+from bench_app import Server  # noqa: E402 (this folder is on the path when the script runs)
 
 KICK_EVERY_S = 10.0
 
@@ -106,39 +109,12 @@ def drawing_group(app: Any, name: str) -> list[Any]:
     return [nodes[n] for n in names[name] if n in nodes]
 
 
-class App:
+class App(Server):
+    """The default TREP app in a child process (this file's ``--serve``), paced or not."""
+
     def __init__(self, pace: bool) -> None:
-        flag = "--pace" if pace else "--no-pace"
-        self.proc = subprocess.Popen(
-            [sys.executable, __file__, "--serve", flag],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            cwd=ROOT,
-        )
-        self.port = int(json.loads(self._line())["port"])
-
-    def _line(self) -> str:
-        assert self.proc.stdout is not None
-        line = self.proc.stdout.readline()
-        if not line:
-            raise RuntimeError("the app process ended early")
-        return line
-
-    def ask(self, command: str = "stats") -> dict[str, Any]:
-        assert self.proc.stdin is not None
-        self.proc.stdin.write(command + "\n")
-        self.proc.stdin.flush()
-        return json.loads(self._line())
-
-    def close(self) -> None:
-        try:
-            assert self.proc.stdin is not None
-            self.proc.stdin.write("quit\n")
-            self.proc.stdin.flush()
-            self.proc.wait(timeout=20)
-        except Exception:
-            self.proc.kill()
+        super().__init__("trep", [sys.executable, __file__, "--serve", "--pace" if pace else "--no-pace"])
+        self.port = int(self.info["port"])
 
 
 # ---------------------------------------------------------------- the page
@@ -258,39 +234,43 @@ def page_figures(page: Any, app: App) -> dict[str, float]:
     return figures
 
 
-def open_page(pw: Any, port: int) -> tuple[Any, Any]:
-    from tests.browser import CHROMIUM, CHROMIUM_FLAGS
-
-    browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
-    page = browser.new_page(viewport={"width": 1400, "height": 900})
-    page.goto(f"http://127.0.0.1:{port}/", timeout=120_000)
-    page.get_by_role("button", name="Kick the base").wait_for(timeout=120_000)
-    page.evaluate(WATCH_STATUS_JS)
-    return browser, page
-
-
-# ---------------------------------------------------------------- scenarios
-def scenario_one_page(pace: bool, minutes: float) -> dict[str, Any]:
+@contextmanager
+def app_and_page(pace: bool) -> Iterator[tuple[App, Any]]:
+    """The app (paced or not) and one software-rendered page showing it, its status line watched."""
     from playwright.sync_api import sync_playwright
+
+    from tests.browser import CHROMIUM, CHROMIUM_FLAGS
 
     app = App(pace)
     try:
         with sync_playwright() as pw:
-            browser, page = open_page(pw, app.port)
-            time.sleep(3.0)
-            delays: list[float] = []
-            start = page_figures(page, app)
-            cpu0, wall0 = chromium_cpu_s(), time.monotonic()
-            t_end = time.monotonic() + 60.0 * minutes
-            while time.monotonic() < t_end:
-                t0 = time.monotonic()
-                delays.append(kick_to_visible(page, app))
-                time.sleep(max(0.0, KICK_EVERY_S - (time.monotonic() - t0)))
-            cpu1, wall1 = chromium_cpu_s(), time.monotonic()
-            end = page_figures(page, app)
-            browser.close()
+            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+            try:
+                page = browser.new_page(viewport={"width": 1400, "height": 900})
+                page.goto(f"http://127.0.0.1:{app.port}/", timeout=120_000)
+                page.get_by_role("button", name="Kick the base").wait_for(timeout=120_000)
+                page.evaluate(WATCH_STATUS_JS)
+                yield app, page
+            finally:
+                browser.close()
     finally:
         app.close()
+
+
+# ---------------------------------------------------------------- scenarios
+def scenario_one_page(pace: bool, minutes: float) -> dict[str, Any]:
+    with app_and_page(pace) as (app, page):
+        time.sleep(3.0)
+        delays: list[float] = []
+        start = page_figures(page, app)
+        cpu0, wall0 = chromium_cpu_s(), time.monotonic()
+        t_end = time.monotonic() + 60.0 * minutes
+        while time.monotonic() < t_end:
+            t0 = time.monotonic()
+            delays.append(kick_to_visible(page, app))
+            time.sleep(max(0.0, KICK_EVERY_S - (time.monotonic() - t0)))
+        cpu1, wall1 = chromium_cpu_s(), time.monotonic()
+        end = page_figures(page, app)
     k = max(1, min(3, len(delays) // 3))
     cpu = {kind: 100.0 * (cpu1[kind] - cpu0[kind]) / (wall1 - wall0) for kind in cpu0}
     return {"start": start, "end": end, "kick_start": delays[:k], "kick_end": delays[-k:], "kicks": len(delays)} | {
@@ -299,29 +279,21 @@ def scenario_one_page(pace: bool, minutes: float) -> dict[str, Any]:
 
 
 def scenario_crowd(pace: bool, seconds: float) -> dict[str, Any]:
-    from playwright.sync_api import sync_playwright
-
     from tests.protocol_client import ProtocolClient
 
-    app = App(pace)
-    clients: list[ProtocolClient] = []
-    try:
-        with sync_playwright() as pw:
-            browser, page = open_page(pw, app.port)
-            clients = [ProtocolClient(app.port, decode=True, watch_node="/base/link1") for _ in range(3)]
+    with app_and_page(pace) as (app, page):
+        clients = [ProtocolClient(app.port, decode=True, watch_node="/base/link1") for _ in range(3)]
+        try:
             app.ask("cyclic")
             time.sleep(5.0)
             a, since = app.ask(), time.perf_counter()
-            page.evaluate("() => { window.__frames = 0; }")
             time.sleep(seconds)
             b = app.ask()
             fast = [c.rate(c.pose_times, since) for c in clients]
             figures = page_figures(page, app)
-            browser.close()
-    finally:
-        for c in clients:
-            c.close()
-        app.close()
+        finally:
+            for c in clients:
+                c.close()
     wall = b["wall"] - a["wall"]
     return {
         "rtf": (b["sim_t"] - a["sim_t"]) / wall,
@@ -335,9 +307,6 @@ def scenario_crowd(pace: bool, seconds: float) -> dict[str, Any]:
 def scenario_cost(seconds: float) -> list[tuple[str, dict[str, float], dict[str, float]]]:
     """Per group of COST_GROUPS: the page's frames and chromium's CPU per frame with everything drawn
     and with that group hidden (measured back to back; the ratio is what the group costs)."""
-    from playwright.sync_api import sync_playwright
-
-    app = App(pace=False)  # every frame sent: what drawing costs, not what pacing saves
 
     def measure(page: Any) -> dict[str, float]:
         cpu0 = chromium_cpu_s()
@@ -348,55 +317,42 @@ def scenario_cost(seconds: float) -> list[tuple[str, dict[str, float], dict[str,
         return {"raf_hz": raf_hz, "renderer_ms": per["renderer"], "gpu_ms": per["gpu"]}
 
     rows = []
-    try:
-        with sync_playwright() as pw:
-            browser, page = open_page(pw, app.port)
-            app.ask("cyclic")
-            time.sleep(8.0)  # the path family is computed and drawn
-            for name in COST_GROUPS:
-                with_it = measure(page)
-                app.ask(f"hide:{name}")
-                time.sleep(1.0)
-                without = measure(page)
-                app.ask(f"show:{name}")
-                time.sleep(1.0)
-                rows.append((name, with_it, without))
-            browser.close()
-    finally:
-        app.close()
+    with app_and_page(pace=False) as (app, page):  # every frame sent: what drawing costs, not what pacing saves
+        app.ask("cyclic")
+        time.sleep(8.0)  # the path family is computed and drawn
+        for name in COST_GROUPS:
+            with_it = measure(page)
+            app.ask(f"hide:{name}")
+            time.sleep(1.0)
+            without = measure(page)
+            app.ask(f"show:{name}")
+            time.sleep(1.0)
+            rows.append((name, with_it, without))
     return rows
 
 
 def scenario_hidden(pace: bool, minutes: float) -> dict[str, Any]:
-    from playwright.sync_api import sync_playwright
-
-    app = App(pace)
-    try:
-        with sync_playwright() as pw:
-            browser, page = open_page(pw, app.port)
-            time.sleep(5.0)
-            cdp = page.context.new_cdp_session(page)
-            cdp.send("Debugger.enable")
-            page.evaluate(HIDE_JS, True)
-            cdp.send("Debugger.pause")
-            time.sleep(60.0 * minutes)
-            shown = time.monotonic()
-            cdp.send("Debugger.resume")
-            cdp.send("Debugger.disable")
-            page.evaluate(HIDE_JS, False)
-            live_s = time.monotonic() - shown
-            server_t = app.ask()["sim_t"]
-            current_s = float("nan")
-            while time.monotonic() - shown < 600.0:
-                log = page.evaluate("() => window.__statusLog")
-                if log and log[-1][1] >= server_t:
-                    current_s = time.monotonic() - shown
-                    break
-                time.sleep(0.05)
-            kick_s = kick_to_visible(page, app)
-            browser.close()
-    finally:
-        app.close()
+    with app_and_page(pace) as (app, page):
+        time.sleep(5.0)
+        cdp = page.context.new_cdp_session(page)
+        cdp.send("Debugger.enable")
+        page.evaluate(HIDE_JS, True)
+        cdp.send("Debugger.pause")  # the main thread stops, as in a frozen background tab
+        time.sleep(60.0 * minutes)
+        shown = time.monotonic()
+        cdp.send("Debugger.resume")
+        cdp.send("Debugger.disable")
+        page.evaluate(HIDE_JS, False)
+        live_s = time.monotonic() - shown
+        server_t = app.ask()["sim_t"]
+        current_s = float("nan")
+        while time.monotonic() - shown < 600.0:
+            log = page.evaluate("() => window.__statusLog")
+            if log and log[-1][1] >= server_t:
+                current_s = time.monotonic() - shown
+                break
+            time.sleep(0.05)
+        kick_s = kick_to_visible(page, app)
     return {"live_s": live_s, "current_s": current_s, "kick_s": kick_s}
 
 
