@@ -33,6 +33,7 @@ from __future__ import annotations
 import asyncio
 import threading
 import time
+import traceback
 import warnings
 from collections.abc import AsyncGenerator, Callable, Sequence
 from contextlib import suppress
@@ -89,23 +90,31 @@ class PagePace:
             return {"hz": c.hz, "answer_s": c.last_answer_s, "held": c.held(time.monotonic()), "notice": c.noticed}
 
     def _run(self) -> None:
-        client_id = self.client.client_id
-        while not self._stop.is_set() and self._is_connected(client_id):
-            with self._lock:
-                self.control.ping_sent(time.monotonic())
-            try:
-                self.client.local_storage.get_item(PING_KEY, timeout=HOLD_S)
-            except TimeoutError:  # ask again; the oldest unanswered question keeps counting
-                self._refresh_notice()
-                continue
-            except RuntimeError:  # the client left, or its browser refused localStorage (still an answer)
-                if not self._is_connected(client_id):
-                    return
-            with self._lock:
-                self.control.ping_answered(time.monotonic())
-            self.answered_once = True
+        try:
+            while not self._stop.is_set() and self._is_connected(self.client.client_id):
+                self._ask_once()
+        except Exception:  # pacing must never cost the page its updates: it goes unpaced
+            traceback.print_exc()
+        finally:
+            self.answered_once = False  # a page nobody asks any more is never held
+
+    def _ask_once(self) -> None:
+        """One question, its answer timed into the controller; the notice brought up to date."""
+        with self._lock:
+            self.control.ping_sent(time.monotonic())
+        try:
+            self.client.local_storage.get_item(PING_KEY, timeout=HOLD_S)
+        except TimeoutError:  # ask again; the oldest unanswered question keeps counting
             self._refresh_notice()
-            self._stop.wait(PING_GAP_S)
+            return
+        except RuntimeError:  # the client left, or its browser refused localStorage (still an answer)
+            if not self._is_connected(self.client.client_id):
+                return
+        with self._lock:
+            self.control.ping_answered(time.monotonic())
+        self.answered_once = True
+        self._refresh_notice()
+        self._stop.wait(PING_GAP_S)
 
     def _refresh_notice(self) -> None:
         """Show, restate or remove the slowed-display notice on this client."""
