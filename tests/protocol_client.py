@@ -7,8 +7,8 @@ bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack
 counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
 element (update rates for benchmarks). Like a browser it answers the server's localStorage
 questions (the app times them to pace slow pages, rns_viz.viz.client_pace); ``answer_delay_s``
-answers late, as a page that draws slowly does, and ``frozen`` (an Event) stops answering, as a
-frozen tab does. Only connects to loopback addresses (docs/testing-notes.md says why).
+answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the answers back
+until ``thaw()``, as a frozen tab does. Only connects to loopback addresses (docs/testing-notes.md says why).
 """
 
 from __future__ import annotations
@@ -61,7 +61,8 @@ class ProtocolClient:
         self.pose_times: list[float] = []  # perf_counter times of windows that moved ``watch_node``
         self.gui_times: dict[str, list[float]] = {}  # uuid -> perf_counter times of its updates
         self.answer_delay_s = answer_delay_s  # s: how late the page answers the server's questions
-        self.frozen = threading.Event()  # set: questions go unanswered (until cleared)
+        self.frozen = threading.Event()  # set: questions wait for thaw()
+        self._deferred: list[str] = []
         self.answers = 0
         self.closed = threading.Event()
         self._zstd = zstandard.ZstdDecompressor()
@@ -174,8 +175,10 @@ class ProtocolClient:
             self._count(window["messages"], now)
 
     def _answer(self, request_uuid: str) -> None:
-        """Answer a localStorage question now, later (``answer_delay_s``) or not at all (``frozen``)."""
+        """Answer a localStorage question now, later (``answer_delay_s``) or, while ``frozen``, on
+        :meth:`thaw`."""
         if self.frozen.is_set():
+            self._deferred.append(request_uuid)
             return
         reply = _messages.LocalStorageGetItemResponseMessage(value=None, error=None, request_uuid=request_uuid)
         if self.answer_delay_s > 0.0:
@@ -185,6 +188,13 @@ class ProtocolClient:
         else:
             self._send_quietly(reply)
         self.answers += 1
+
+    def thaw(self) -> None:
+        """Answer the questions that came while frozen (in order, as a thawed tab does), then go on."""
+        self.frozen.clear()
+        deferred, self._deferred = self._deferred, []
+        for request_uuid in deferred:
+            self._answer(request_uuid)
 
     def _send_quietly(self, message: _messages.Message) -> None:
         with contextlib.suppress(ConnectionClosed, OSError):

@@ -18,10 +18,12 @@ from rns_viz.viz.client_pace import _paced
 from rns_viz.viz.pace_control import (
     FAST_ANSWER_S,
     FULL_HZ,
+    HOLD_BASES,
     HOLD_S,
     MIN_HZ,
     NOTICE_BELOW_HZ,
     NOTICE_GONE_HZ,
+    QUEUE_GROWS_S,
     SLOW_ANSWER_S,
     PaceController,
 )
@@ -61,6 +63,18 @@ def test_answers_in_between_keep_the_rate() -> None:
     c = PaceController(hz=20.0)
     answer(c, 0.0, 0.5 * (FAST_ANSWER_S + SLOW_ANSWER_S))
     assert c.hz == 20.0
+
+
+def test_a_page_slow_to_draw_but_building_no_queue_keeps_its_rate_and_a_queue_halves_it() -> None:
+    c, now, frame_s = PaceController(), 0.0, 0.5 * (FAST_ANSWER_S + SLOW_ANSWER_S)  # one slow frame per answer
+    for _ in range(30):
+        now = answer(c, now, frame_s) + 0.25
+    assert c.hz == FULL_HZ and c.base_s() == pytest.approx(frame_s)
+    now = answer(c, now, frame_s + 2.0 * QUEUE_GROWS_S)  # the same page, now with a queue
+    assert c.hz == FULL_HZ / 2
+    c.ping_sent(now)  # such a page is held only after several of its own answer times
+    assert not c.held(now + HOLD_S) or HOLD_BASES * frame_s <= HOLD_S
+    assert c.held(now + max(HOLD_S, HOLD_BASES * frame_s))
 
 
 def test_a_page_that_catches_up_climbs_back_and_the_notice_goes_when_it_is_nearly_there() -> None:
@@ -158,11 +172,11 @@ def test_a_slow_client_gets_fewer_updates_a_fast_one_all_and_a_frozen_one_none(t
 
         # A frozen page: nothing more is sent to it until it answers; then the current state.
         slow.frozen.set()
-        wait_until(lambda: app.pace.state(slow_id)["held"], 10.0, "the frozen client to be held")
+        wait_until(lambda: app.pace.state(slow_id)["held"], 30.0, "the frozen client to be held")
         time.sleep(0.5)
         assert poses_during(slow, 2.0) == 0 and poses_during(fast, 0.5) > 0
         slow.answer_delay_s = 0.0
-        slow.frozen.clear()
+        slow.thaw()
         wait_until(lambda: not app.pace.state(slow_id)["held"], 10.0, "the thawed client to answer")
         wait_until(lambda: app.pace.state(slow_id)["hz"] == FULL_HZ, 30.0, "the thawed client's full rate")
         wait_until(lambda: not app.pace.state(slow_id)["notice"], 5.0, "the notice to go")

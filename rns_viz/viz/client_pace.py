@@ -18,7 +18,7 @@ the same node property or GUI property replaces the older one. A client whose st
 less often therefore gets the newest state of everything, never a backlog: that is how viser
 already treats a client on a slow link. :func:`install_gate` makes the per-client reader of that
 buffer wait between windows for a paced client (and wait altogether while a question has gone
-unanswered for a second: a frozen or hidden tab gets nothing until it answers, then the latest
+unanswered for a few seconds: a frozen or hidden tab gets nothing until it answers, then the latest
 state). This wraps one method of viser's broadcast buffer (``window_generator``, viser 1.1.1);
 if viser changes it the app warns and runs unpaced. The per-client stream (notifications,
 operator panel, the questions themselves) and everything the browser sends (buttons, drags,
@@ -41,7 +41,7 @@ from typing import Any
 
 import viser
 
-from rns_viz.viz.pace_control import HOLD_S, PaceController
+from rns_viz.viz.pace_control import PaceController
 
 PING_KEY = "rns_viz_pace"  # the localStorage key asked for (its value does not matter)
 PING_GAP_S = 0.25  # s between an answer and the next question
@@ -102,11 +102,8 @@ class PagePace:
         """One question, its answer timed into the controller; the notice brought up to date."""
         with self._lock:
             self.control.ping_sent(time.monotonic())
-        try:
-            self.client.local_storage.get_item(PING_KEY, timeout=HOLD_S)
-        except TimeoutError:  # ask again; the oldest unanswered question keeps counting
-            self._refresh_notice()
-            return
+        try:  # no time limit: a frozen tab answers when it thaws, and until then it is held
+            self.client.local_storage.get_item(PING_KEY)
         except RuntimeError:  # the client left, or its browser refused localStorage (still an answer)
             if not self._is_connected(self.client.client_id):
                 return
@@ -118,6 +115,8 @@ class PagePace:
 
     def _refresh_notice(self) -> None:
         """Show, restate or remove the slowed-display notice on this client."""
+        if not self._is_connected(self.client.client_id):
+            return
         now = time.monotonic()
         with self._lock:
             show = self.control.update_notice(now)
