@@ -22,6 +22,7 @@ runs in a child process (its real-time factor is not disturbed by the clients); 
    a frozen background tab) for --hidden-minutes, then shown: time until the page answers a
    script at all ("live") and until it shows the server's current time, then Kick -> visible.
 
+What one frame costs, group by group: benchmarks/bench_frame_cost.py (uses this file's app).
 The lead re-runs this on a quiet machine; `uptime` load is printed with the figures.
 """
 
@@ -70,6 +71,8 @@ def serve(pace: bool) -> None:
         if command == "cyclic":
             s.cyclic(True)
         if command.startswith(("hide:", "show:")):
+            from bench_frame_cost import drawing_group
+
             for handle in drawing_group(app, command[5:]):
                 handle.visible = command.startswith("show:")
         clients = sorted(app.server.get_clients())
@@ -82,31 +85,6 @@ def serve(pace: bool) -> None:
         }
         print(json.dumps(stats), file=out, flush=True)
     app.stop()
-
-
-# What the page draws, in groups that can be hidden one at a time to see what a frame costs.
-COST_GROUPS = ("paths", "ghost", "labels", "grid", "beam", "robot", "arrows", "reach+trail", "plots", "all 3-D")
-
-
-def drawing_group(app: Any, name: str) -> list[Any]:
-    """Handles of one group of COST_GROUPS (scene nodes by name or kind; the plots' charts)."""
-    if name == "plots":
-        return [c for charts in app.gui.plots.charts.values() for c in charts.values() if c.visible] + [
-            app.gui.plots.error
-        ]
-    nodes = app.server.scene._handle_from_node_name  # viser 1.1.1: name -> handle
-    kinds = {"labels": "LabelHandle", "robot": "GlbHandle", "arrows": "ArrowsHandle"}
-    names = {
-        "paths": ("/base/paths", "/base/path_arrows"),
-        "ghost": ("/ghost",),
-        "grid": ("/grid",),
-        "beam": ("/beam/edges", "/beam/plates"),
-        "reach+trail": ("/base/reachable", "/base/reach_outline", "/base/trail"),
-        "all 3-D": ("/base", "/beam", "/ghost", "/grid", "/gain_map"),
-    }
-    if name in kinds:
-        return [h for h in nodes.values() if type(h).__name__ == kinds[name]]
-    return [nodes[n] for n in names[name] if n in nodes]
 
 
 class App(Server):
@@ -308,35 +286,6 @@ def scenario_crowd(pace: bool, seconds: float) -> dict[str, Any]:
     }
 
 
-def scenario_cost(
-    seconds: float, groups: tuple[str, ...] = COST_GROUPS
-) -> list[tuple[str, dict[str, float], dict[str, float]]]:
-    """Per group of COST_GROUPS: the page's frames and chromium's CPU per frame with everything drawn
-    and with that group hidden (measured back to back; the ratio is what the group costs)."""
-
-    def measure(page: Any) -> dict[str, float]:
-        cpu0 = chromium_cpu_s()
-        raf_hz = page.evaluate(RAF_JS, int(1000 * seconds))
-        cpu1 = chromium_cpu_s()
-        frames = max(1.0, raf_hz * seconds)
-        per = {k: 1e3 * (cpu1[k] - cpu0[k]) / frames for k in cpu0}
-        return {"raf_hz": raf_hz, "renderer_ms": per["renderer"], "gpu_ms": per["gpu"]}
-
-    rows = []
-    with app_and_page(pace=False) as (app, page):  # every frame sent: what drawing costs, not what pacing saves
-        app.ask("cyclic")
-        time.sleep(8.0)  # the path family is computed and drawn
-        for name in groups:
-            with_it = measure(page)
-            app.ask(f"hide:{name}")
-            time.sleep(1.0)
-            without = measure(page)
-            app.ask(f"show:{name}")
-            time.sleep(1.0)
-            rows.append((name, with_it, without))
-    return rows
-
-
 def scenario_hidden(pace: bool, minutes: float) -> dict[str, Any]:
     with app_and_page(pace) as (app, page):
         time.sleep(5.0)
@@ -380,8 +329,7 @@ def main() -> None:
     parser.add_argument("--minutes", type=float, default=5.0, help="minutes of the one-page run (each mode)")
     parser.add_argument("--crowd-seconds", type=float, default=60.0, help="seconds of the page + 3 clients run")
     parser.add_argument("--hidden-minutes", type=float, default=2.0, help="minutes the tab stays hidden")
-    parser.add_argument("--only", choices=("page", "crowd", "hidden", "cost"), help="run one scenario")
-    parser.add_argument("--groups", help=f"cost: these groups only (comma-separated of {', '.join(COST_GROUPS)})")
+    parser.add_argument("--only", choices=("page", "crowd", "hidden"), help="run one scenario")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--pace", action=argparse.BooleanOptionalAction, default=True, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -417,16 +365,6 @@ def main() -> None:
         row("scene Hz at the fast clients (slowest)", min(on["fast_hz"]), min(off["fast_hz"]), "Hz", "target >= 30")
         row("page rate chosen by the server", on["page_pace_hz"], off["page_pace_hz"], "Hz")
         row("page rAF rate", on["page_raf_hz"], off["page_raf_hz"], "Hz")
-    if args.only in (None, "cost"):
-        rows = scenario_cost(4.0, tuple(args.groups.split(",")) if args.groups else COST_GROUPS)
-        print(f"\n== what a frame costs: each group hidden in turn (unpaced, cyclic motion)  [{load()}]")
-        head = ("group", "rAF Hz with / without", "renderer CPU ms/frame", "GPU-process ms/frame")
-        print(f"  {head[0]:<12} {head[1]:>22} {head[2]:>24} {head[3]:>22}")
-        for name, a, b in rows:
-            print(
-                f"  {name:<12} {a['raf_hz']:>10.1f} / {b['raf_hz']:<9.1f} {a['renderer_ms']:>11.1f} / "
-                f"{b['renderer_ms']:<10.1f} {a['gpu_ms']:>10.1f} / {b['gpu_ms']:<9.1f}"
-            )
     if args.only in (None, "hidden"):
         runs = {p: scenario_hidden(p, args.hidden_minutes) for p in (True, False)}
         on, off = runs[True], runs[False]
