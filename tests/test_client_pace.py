@@ -97,7 +97,9 @@ def test_a_page_that_catches_up_climbs_back_and_the_notice_goes_when_it_is_nearl
 def test_an_unanswered_question_holds_the_stream_until_it_is_answered() -> None:
     c = PaceController()
     c.ping_sent(10.0)
-    assert not c.held(10.0 + 0.5 * HOLD_S) and c.wait_s(10.0 + 0.5 * HOLD_S, 1.0) == 0.0
+    assert c.wait_s(10.0 + 0.5 * SLOW_ANSWER_S, 0.0) == 0.0  # not late yet: full rate
+    late = 10.0 + 0.5 * (SLOW_ANSWER_S + HOLD_S)  # late, not yet held: the slowest rate
+    assert not c.held(late) and c.wait_s(late, 0.25) == pytest.approx(1.0 / MIN_HZ - 0.25)
     assert c.held(10.0 + HOLD_S) and math.isinf(c.wait_s(10.0 + HOLD_S, 1e3))
     assert c.update_notice(10.0 + HOLD_S)
     c.ping_sent(11.5)  # asked again: the oldest question still counts

@@ -12,6 +12,8 @@ rest is a queue. The rule is additive-increase / multiplicative-decrease on both
 - an answer within ``FAST_ANSWER_S`` and a queue under ``QUEUE_EMPTY_S``: raise the rate by half
   (plus 2 Hz) up to the full rate (from 1 Hz back to full in 7 answers, about 2 s);
 - otherwise keep it; a page that is slow but builds no queue keeps its rate;
+- a question unanswered for ``SLOW_ANSWER_S`` (or two of the page's quickest answers): send at
+  ``MIN_HZ`` until the answer comes, which then sets the rate;
 - a question unanswered for ``HOLD_S`` (or four of the page's quickest answers, if longer): the
   page is frozen, hidden or very busy; send it nothing until it answers (then it gets the latest
   state at once, never the backlog).
@@ -81,7 +83,10 @@ class PaceController:
         question is asked again later, so a short wait that is checked again."""
         if self.held(now):
             return math.inf
-        return max(0.0, self.interval_s() - since_last_send_s)
+        interval = self.interval_s()
+        if self.asked_at is not None and now - self.asked_at > max(SLOW_ANSWER_S, 2.0 * self.base_s()):
+            interval = 1.0 / MIN_HZ  # an answer is late already: slow down before it comes (or the hold)
+        return max(0.0, interval - since_last_send_s)
 
     def shown_hz(self) -> int:
         """The rate the notice states (whole Hz)."""
