@@ -67,7 +67,8 @@ def shown_time(page: Page) -> float:
 
 
 def notice_shown(page: Page) -> bool:
-    return page.get_by_text(NOTICE).count() > 0
+    lines = page.get_by_text(NOTICE)
+    return any(lines.nth(k).is_visible() for k in range(lines.count()))
 
 
 def test_a_throttled_page_is_slowed_told_so_still_operates_and_recovers(trep_app: RnsApp) -> None:

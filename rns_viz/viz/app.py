@@ -56,7 +56,8 @@ class RnsApp:
         self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
         self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
         self.recorder = SceneRecorder(server, self.connections)
-        self.pace = ClientPace(server, enabled=pace)  # each page gets updates at the rate it can draw
+        # each page gets updates at the rate it can draw; told so under the status line when slowed
+        self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 

@@ -24,8 +24,9 @@ if viser changes it the app warns and runs unpaced. The per-client stream (notif
 operator panel, the questions themselves) and everything the browser sends (buttons, drags,
 the operator lock) are never delayed. A fast client's stream is not touched.
 
-The page is told: a notification "Display slowed to N Hz to keep up" once it is paced below
-NOTICE_BELOW_HZ (or held), removed when it is back at NOTICE_GONE_HZ or more.
+The page is told: a line "Display slowed to N Hz to keep up" under the status line of its own
+panel once it is paced below NOTICE_BELOW_HZ (or held), hidden when it is back at NOTICE_GONE_HZ
+or more. (A line in the panel, not a toast: a toast sits over the scene, where the gain map is.)
 """
 
 from __future__ import annotations
@@ -48,6 +49,10 @@ PING_GAP_S = 0.25  # s between an answer and the next question
 NOTICE_UPDATE_S = 2.0  # s: the notice's rate is restated at most this often
 GATE_POLL_S = 0.05  # s: a held stream checks this often whether it may send again
 SLOWED_TITLE = "Display slowed to {hz} Hz to keep up"
+SLOWED_HTML = (
+    '<div style="font-size:0.85em;border-left:4px solid #e8a600;padding:2px 6px;margin:2px 0">'
+    '<b>{title}</b><br><span style="opacity:0.8">{body}</span></div>'
+)
 SLOWED_BODY = (
     "This browser draws more slowly than the simulation runs, so the server sends it fewer "
     "updates, always the latest state. The simulation and other viewers are unaffected; "
@@ -58,14 +63,17 @@ SLOWED_BODY = (
 class PagePace:
     """One client's controller and the thread that asks its page questions."""
 
-    def __init__(self, client: viser.ClientHandle, is_connected: Callable[[int], bool]) -> None:
+    def __init__(
+        self, client: viser.ClientHandle, is_connected: Callable[[int], bool], order: float | None = None
+    ) -> None:
         self.client = client
+        self._order = order  # where the slowed-display line goes in the client's panel
         self.control = PaceController()
         self.answered_once = False  # unpaced until the page has answered once (its first scene)
         self._is_connected = is_connected
         self._lock = threading.Lock()
         self._stop = threading.Event()
-        self._notice: Any = None  # viser.NotificationHandle while shown
+        self._notice: viser.GuiHtmlHandle | None = None  # the slowed-display line, once shown
         self._notice_hz = 0
         self._notice_time = 0.0
         self.thread = threading.Thread(target=self._run, name=f"rns-pace-{client.client_id}", daemon=True)
@@ -113,8 +121,14 @@ class PagePace:
         self._refresh_notice()
         self._stop.wait(PING_GAP_S)
 
+    def notice_text(self) -> str | None:
+        """The slowed-display line as this client's panel shows it, None while hidden."""
+        line = self._notice
+        return None if line is None or not line.visible else line.content
+
     def _refresh_notice(self) -> None:
-        """Show, restate or remove the slowed-display notice on this client."""
+        """Show, restate or hide the slowed-display line in this client's panel (under the status
+        line; a panel line, not a toast, so it never covers the scene)."""
         if not self._is_connected(self.client.client_id):
             return
         now = time.monotonic()
@@ -122,31 +136,36 @@ class PagePace:
             show = self.control.update_notice(now)
             hz = self.control.shown_hz()
         with suppress(Exception):  # the client may have gone
-            if show and self._notice is None:
-                self._notice = self.client.add_notification(
-                    SLOWED_TITLE.format(hz=hz), SLOWED_BODY, with_close_button=False, color="yellow"
-                )
-                self._notice_hz, self._notice_time = hz, now
-            elif show and hz != self._notice_hz and now - self._notice_time >= NOTICE_UPDATE_S:
-                self._notice.title = SLOWED_TITLE.format(hz=hz)
-                self._notice_hz, self._notice_time = hz, now
-            elif not show and self._notice is not None:
-                self._notice.remove()
-                self._notice = None
+            hidden = self._notice is None or not self._notice.visible
+            restate = hz != self._notice_hz and now - self._notice_time >= NOTICE_UPDATE_S
+            if show and (hidden or restate):
+                self._show_notice(hz, now)
+            elif not show and self._notice is not None and self._notice.visible:
+                self._notice.visible = False
+
+    def _show_notice(self, hz: int, now: float) -> None:
+        content = SLOWED_HTML.format(title=SLOWED_TITLE.format(hz=hz), body=SLOWED_BODY)
+        if self._notice is None:
+            self._notice = self.client.gui.add_html(content, order=self._order)
+        else:
+            self._notice.content = content
+            self._notice.visible = True
+        self._notice_hz, self._notice_time = hz, now
 
 
 class ClientPace:
     """The pace of every connected client, and the gate on the server's broadcast stream."""
 
-    def __init__(self, server: viser.ViserServer, enabled: bool = True) -> None:
+    def __init__(self, server: viser.ViserServer, enabled: bool = True, notice_order: float | None = None) -> None:
         self.server = server
+        self.notice_order = notice_order  # panel order of each client's slowed-display line
         self.pages: dict[int, PagePace] = {}
         self.enabled = enabled and install_gate(server, self._wait_s)
 
     def client_joined(self, client: viser.ClientHandle) -> None:
         if not self.enabled:
             return
-        page = PagePace(client, lambda cid: cid in self.server.get_clients())
+        page = PagePace(client, lambda cid: cid in self.server.get_clients(), self.notice_order)
         self.pages[client.client_id] = page
         page.start()
 
