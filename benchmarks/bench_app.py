@@ -128,9 +128,13 @@ def move_target(app: Any, period: float = 2.5) -> None:
 
 # ---------------------------------------------------------------- client side
 class Server:
-    def __init__(self, model: str, teach: str | None = None) -> None:
+    """The app in a child process that prints its handles as JSON, then one JSON line per command.
+    ``command``: another child (bench_page.py's) instead of this file's ``--serve``."""
+
+    def __init__(self, model: str, teach: str | None = None, command: list[str] | None = None) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, __file__, "--serve", "--model", model, *(["--teach-mode", teach] if teach else [])],
+            command
+            or [sys.executable, __file__, "--serve", "--model", model, *(["--teach-mode", teach] if teach else [])],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -145,11 +149,14 @@ class Server:
             raise RuntimeError("the app process ended early")
         return line
 
-    def stats(self, command: str = "stats") -> dict[str, Any]:
+    def ask(self, command: str = "stats") -> dict[str, Any]:
         assert self.proc.stdin is not None
-        self.proc.stdin.write(f"{command}\n")
+        self.proc.stdin.write(command + "\n")
         self.proc.stdin.flush()
         return json.loads(self._line())
+
+    def stats(self) -> dict[str, Any]:
+        return self.ask("stats")
 
     def close(self) -> None:
         try:
@@ -197,18 +204,18 @@ def scenario_browser(model: str, seconds: float, teach: str | None = None) -> di
             browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
             page = browser.new_page(viewport={"width": 1400, "height": 900})
             page.goto(f"http://127.0.0.1:{srv.info['port']}/", timeout=60_000)
-            wait_until(lambda: srv.stats()["clients"] >= 1, 60.0, "the browser to connect", poll=0.5)
+            wait_until(lambda: srv.ask()["clients"] >= 1, 60.0, "the browser to connect", poll=0.5)
             if model == "trep":
                 page.get_by_role("button", name="Start cyclic motion").click()
             time.sleep(3.0)
-            a = srv.stats()
+            a = srv.ask()
             deadline = time.monotonic() + seconds
             while time.monotonic() < deadline:
                 page.get_by_role("button", name="Kick the base").click()
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
-            b = srv.stats()
+            b = srv.ask()
             if teach == "on":
-                b["replay_rss_mb"] = srv.stats("replay")["rss_mb"]
+                b["replay_rss_mb"] = srv.ask("replay")["rss_mb"]
             browser.close()
         views = {None: "", "off": ", teaching views and recorder off", "on": ", ghost, all overlays and recorder on"}
         summarize(f"one browser (Playwright chromium, software rendering{views[teach]})", a, b, None)
@@ -243,10 +250,10 @@ def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
         thread = threading.Thread(target=kicker, args=(clients[0], srv.info["kick"], stop), daemon=True)
         thread.start()
         time.sleep(2.0)
-        a = srv.stats()
+        a = srv.ask()
         since = time.perf_counter()
         time.sleep(seconds)
-        b = srv.stats()
+        b = srv.ask()
         probe = clients[-1]
         rates = (probe.rate(probe.pose_times, since), probe.rate(probe.gui_times.get(srv.info["plot"], []), since))
         summarize(f"{count} websocket clients", a, b, rates)
@@ -265,8 +272,8 @@ def scenario_latency(model: str, seconds: float) -> None:
     try:
         ws = ProtocolClient(srv.info["port"], decode=False)
         time.sleep(2.0)
-        ee = srv.stats()["ee"]
-        srv.stats()  # clear the latencies so far
+        ee = srv.ask()["ee"]
+        srv.ask()  # clear the latencies so far
         period, k = 0.05, 0
         ws.drag(srv.info["handle"], tuple(ee), "start")
         deadline = time.monotonic() + seconds
@@ -280,7 +287,7 @@ def scenario_latency(model: str, seconds: float) -> None:
             time.sleep(period)
         ws.drag(srv.info["handle"], tuple(ee), "end")
         time.sleep(0.5)
-        lat = sorted(1e3 * x for x in srv.stats()["latencies"])
+        lat = sorted(1e3 * x for x in srv.ask()["latencies"])
         if not lat:
             print("\n== latency: no samples")
             return

@@ -5,11 +5,15 @@ the browser does (msgpack dicts built by viser's own message classes: camera rep
 transform drags) and drains what the server sends on a background thread, counting messages and
 bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack windows and
 counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
-element (update rates for benchmarks). Only connects to loopback addresses (docs/testing-notes.md says why).
+element (update rates for benchmarks). Like a browser it answers the server's localStorage
+questions (the app times them to pace slow pages, rns_viz.viz.client_pace); ``answer_delay_s``
+answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the answers back
+until ``thaw()``, as a frozen tab does. Only connects to loopback addresses (docs/testing-notes.md says why).
 """
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
 from collections import Counter
@@ -36,6 +40,7 @@ class ProtocolClient:
         timeout: float = 20.0,
         decode: bool = False,
         watch_node: str = "/base",
+        answer_delay_s: float = 0.0,
     ) -> None:
         if not (host.startswith("127.") or host in ("localhost", "::1")):
             raise ValueError("protocol clients only connect to this machine")
@@ -55,6 +60,10 @@ class ProtocolClient:
         self.gui_updates: Counter[str] = Counter()  # GUI element uuid -> GuiUpdateMessages
         self.pose_times: list[float] = []  # perf_counter times of windows that moved ``watch_node``
         self.gui_times: dict[str, list[float]] = {}  # uuid -> perf_counter times of its updates
+        self.answer_delay_s = answer_delay_s  # s: how late the page answers the server's questions
+        self.frozen = threading.Event()  # set: questions wait for thaw()
+        self._deferred: list[str] = []
+        self.answers = 0
         self.closed = threading.Event()
         self._zstd = zstandard.ZstdDecompressor()
         self._lock = threading.Lock()
@@ -146,20 +155,55 @@ class ProtocolClient:
                 self.messages += 1
                 self.bytes += len(frame)
                 self.last_message_time = time.monotonic()
-                if self.decode and isinstance(frame, bytes):
-                    self._count(frame, now)
+                if isinstance(frame, bytes):
+                    self._read(frame, now)
         except (ConnectionClosed, OSError):
             pass
         finally:
             self.closed.set()
 
-    def _count(self, frame: bytes, now: float) -> None:
-        """Count the messages of one server window: 8-byte size, 8-byte compressed size, zstd msgpack."""
+    def _read(self, frame: bytes, now: float) -> None:
+        """Answer the questions in one server window (8-byte size, 8-byte compressed size, zstd
+        msgpack) and, with ``decode``, count its messages."""
         size = int.from_bytes(frame[0:8], "little")
         compressed = int.from_bytes(frame[8:16], "little")
         window = msgspec.msgpack.decode(self._zstd.decompress(frame[16 : 16 + compressed], max_output_size=size))
-        moved = False
         for msg in window["messages"]:
+            if msg.get("type") == "LocalStorageGetItemRequestMessage":
+                self._answer(msg["request_uuid"])
+        if self.decode:
+            self._count(window["messages"], now)
+
+    def _answer(self, request_uuid: str) -> None:
+        """Answer a localStorage question now, later (``answer_delay_s``) or, while ``frozen``, on
+        :meth:`thaw`."""
+        if self.frozen.is_set():
+            self._deferred.append(request_uuid)
+            return
+        reply = _messages.LocalStorageGetItemResponseMessage(value=None, error=None, request_uuid=request_uuid)
+        if self.answer_delay_s > 0.0:
+            timer = threading.Timer(self.answer_delay_s, self._send_quietly, (reply,))
+            timer.daemon = True
+            timer.start()
+        else:
+            self._send_quietly(reply)
+        self.answers += 1
+
+    def thaw(self) -> None:
+        """Answer the questions that came while frozen (in order, as a thawed tab does), then go on."""
+        self.frozen.clear()
+        deferred, self._deferred = self._deferred, []
+        for request_uuid in deferred:
+            self._answer(request_uuid)
+
+    def _send_quietly(self, message: _messages.Message) -> None:
+        with contextlib.suppress(ConnectionClosed, OSError):
+            self._send(message)
+
+    def _count(self, messages: list[dict[str, Any]], now: float) -> None:
+        """Count the messages of one server window."""
+        moved = False
+        for msg in messages:
             kind = msg.get("type", "?")
             self.types[kind] += 1
             if "name" in msg:

@@ -1,9 +1,10 @@
 """The live app: a viser server showing a :class:`~rns_viz.live.session.Session`.
 
-Three parts, one concern each: :class:`~rns_viz.viz.inputs.Controls` turns GUI input into the
+Four parts, one concern each: :class:`~rns_viz.viz.inputs.Controls` turns GUI input into the
 session's command methods; :class:`~rns_viz.viz.connections.Connections` holds the clients, the
 operator lock and the password; :class:`~rns_viz.viz.render.Renderer` runs the render thread that
-sends the session's snapshots, plots, text, overlays and notices to the browsers.
+sends the session's snapshots, plots, text, overlays and notices to the browsers;
+:class:`~rns_viz.viz.client_pace.ClientPace` paces what each browser receives to what it can draw.
 
     serve()                      # TREP on http://127.0.0.1:8080, blocking
     app = start_app(port=0)      # non-blocking; app.port, app.session, app.gui; app.stop()
@@ -21,6 +22,7 @@ import viser
 from rns_viz.live.operator_lock import OperatorLock
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
+from rns_viz.viz.client_pace import ClientPace
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gui import GuiElements, make_gui
 from rns_viz.viz.inputs import Controls
@@ -38,7 +40,9 @@ IDLE_RESTART_S = 60.0  # s of simulated time: a session older than this restarts
 class RnsApp:
     """The GUI and scene of one session on one viser server."""
 
-    def __init__(self, server: viser.ViserServer, session: Session, password: str | None = None) -> None:
+    def __init__(
+        self, server: viser.ViserServer, session: Session, password: str | None = None, pace: bool = True
+    ) -> None:
         self.server = server
         self.session = session
         self.password = password
@@ -53,6 +57,8 @@ class RnsApp:
         self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
         self.replay = ReplayPanel(server, session, self.controls, self.connections, self.view)
         self.renderer.text_panels.append(self.replay.refresh)
+        # each page gets updates at the rate it can draw; told so under the status line when slowed
+        self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
@@ -104,6 +110,7 @@ class RnsApp:
         return self
 
     def stop(self) -> None:
+        self.pace.stop()
         self.renderer.stop()
         self.session.stop()
         self.server.stop()
@@ -112,6 +119,7 @@ class RnsApp:
         """Register the client; the first visitor of an unwatched session that ran on for a while gets
         it from the start (not "t = 4365 s" of a kick nobody saw)."""
         self.connections.client_joined(client)
+        self.pace.client_joined(client)
         if self.connections.client_count() == 1 and self.session.snapshot().t > IDLE_RESTART_S:
             self.session.reset()
 
@@ -119,6 +127,7 @@ class RnsApp:
         """End the client's drag while it still counts as the operator, then pass control on."""
         self.controls.client_left(client.client_id)
         self.connections.client_left(client.client_id)
+        self.pace.client_left(client.client_id)
 
 
 def start_app(
@@ -129,14 +138,16 @@ def start_app(
     realtime: bool = True,
     verbose: bool = True,
     lesson: int | None = None,
+    pace: bool = True,
 ) -> RnsApp:
     """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
-    ``lesson``: start at that lesson (1-based) of the model."""
+    ``lesson``: start at that lesson (1-based) of the model; ``pace=False``: every page gets every
+    update however slowly it draws (for comparisons; see :mod:`rns_viz.viz.client_pace`)."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password).start()
+        app = RnsApp(server, session, password, pace=pace).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:

@@ -24,6 +24,9 @@ from rns_viz.viz.style import CartSpringStyle, DoubleBeamStyle, SceneStyle, styl
 
 PATH_COLOUR = (0.62, 0.74, 0.88)  # other reactionless paths, RGB in [0, 1]
 PATH_HIGHLIGHT = (0.90, 0.05, 0.30)  # the current path
+# The family is drawn in screen pixels: world-unit lines get a second, blended antialiasing pass in
+# viser's client, which made the ~1200 segments the costliest node of a software-rendered frame.
+PATH_WIDTH_PX = 4.0
 TRAIL_COLOUR = (0.20, 0.65, 0.30)
 FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
 TARGET_COLOUR = (30, 170, 90)
@@ -79,7 +82,13 @@ class FsmsScene:
         self.base_node = self.robot.base_node
         self.base_drawing = _make_base_drawing(server, model, st.base)
         self.paths = scene.add_line_segments(
-            self.PATHS, np.zeros((1, 2, 3)), PATH_COLOUR, thickness=st.line_thickness, position=lift, visible=False
+            self.PATHS,
+            np.zeros((1, 2, 3)),
+            PATH_COLOUR,
+            thickness=PATH_WIDTH_PX,
+            thickness_units="screen",
+            position=lift,
+            visible=False,
         )
         self._path_owners = np.zeros(0, dtype=int)
         self.current_path: int | None = None
