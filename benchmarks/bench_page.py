@@ -91,7 +91,7 @@ class App(Server):
     """The default TREP app in a child process (this file's ``--serve``), paced or not."""
 
     def __init__(self, pace: bool) -> None:
-        super().__init__("trep", [sys.executable, __file__, "--serve", "--pace" if pace else "--no-pace"])
+        super().__init__("trep", command=[sys.executable, __file__, "--serve", "--pace" if pace else "--no-pace"])
         self.port = int(self.info["port"])
 
 
