@@ -18,7 +18,7 @@ Kicks. "An arbitrary external force" (Sec. VII-D): a half-sine push on the base 
 31 kg base (0.64 N s, about 1.1 cm); law (15) absorbs a deflection by moving the arm's centre of
 mass, so a much larger kick needs more than the arm's reach and drives it into H_bm = 0.
 
-boom7 (the spatial model; not yet served by the app): law (15) with g_b = 10, G_m = 2 on all six
+boom7 (the spatial model): law (15) with g_b = 10, G_m = 2 on all six
 tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
 about 1.3 mm of a 4 m boom, drawn 50x). Its kick needs a direction: along the first base
 coordinate alone it would push the stiff axial mode (170 Hz, 1e-7 m).
@@ -29,6 +29,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rns_viz.control import Gains, LawKind
+from rns_viz.params import model_source
 
 
 @dataclass(frozen=True)
@@ -84,5 +85,5 @@ GENERIC_DEFAULTS = ModelDefaults(law="acceleration")
 
 
 def defaults_for(model: str) -> ModelDefaults:
-    """The defaults of a bundled model; a model from a parameter file gets generic ones."""
-    return MODEL_DEFAULTS.get(model, GENERIC_DEFAULTS)
+    """The defaults of a bundled model (by name or model key); a model from a parameter file gets generic ones."""
+    return MODEL_DEFAULTS.get(model_source(model), GENERIC_DEFAULTS)

@@ -34,7 +34,7 @@ _models: dict[str, FsmsModel] = {}
 
 def _model(name: str) -> FsmsModel:
     if name not in _models:
-        _models[name] = FsmsModel.from_name(name)
+        _models[name] = FsmsModel.from_key(name)
     return _models[name]
 
 

@@ -25,13 +25,13 @@ REACTION_EVERY = 4  # steps between evaluations of the arm's reaction (250 Hz: e
 
 
 def reference_point(model: FsmsModel, out: ControlOutput | None) -> np.ndarray | None:
-    """Where the law sends the end effector (base frame x, y, m), or None without a reference."""
+    """Where the law sends the end effector (base frame, m, the model's task axes), or None without a reference."""
     if out is None:
         return None
     if out.ee_ref is not None:
-        return np.asarray(out.ee_ref)[:2]
+        return np.asarray(out.ee_ref)[: len(model.task_rows)]
     if out.theta_ref is not None:
-        return model.ee_position(out.theta_ref)[:2]
+        return model.ee_position(out.theta_ref)[model.task_rows]
     return None
 
 
@@ -86,7 +86,7 @@ class Outputs:
         self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool, suppress: bool
     ) -> None:
         sim, shadow = runs.sim, runs.shadow
-        x = model.ee_position(sim.q[model.m :])[:2]
+        x = model.ee_position(sim.q[model.m :])[model.task_rows]
         ref = reference_point(model, out)
         self.ee_error = float(np.linalg.norm(ref - x)) if ref is not None else math.nan
         shadow_out = shadow.last if shadow_on else None
