@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from rns_viz.control import ControlOutput
-from rns_viz.live.plots import PlotBuffers
+from rns_viz.live.plots import BASE_COORDINATES, PlotBuffers
 from rns_viz.live.reaction import ReactionProbe
 from rns_viz.live.readouts import compute_readouts
 from rns_viz.live.records import Readouts
@@ -90,15 +90,18 @@ class Outputs:
         ref = reference_point(model, out)
         self.ee_error = float(np.linalg.norm(ref - x)) if ref is not None else math.nan
         shadow_out = shadow.last if shadow_on else None
+        coordinates = np.full(BASE_COORDINATES, math.nan)
+        coordinates[: model.m] = sim.q[: model.m] * 1e3
         self.plots.append(
             (
                 sim.t,
-                sim.q[0] * 1e3,
-                shadow.q[0] * 1e3 if shadow_on else math.nan,
+                deflection(sim.q, model.m) * 1e3,
+                deflection(shadow.q, model.m) * 1e3 if shadow_on else math.nan,
                 L_of(out),
                 L_of(shadow_out) if shadow_out is not None else math.nan,
                 self.ee_error * 1e3,
                 float(suppress),
+                *coordinates,
             )
         )
 
@@ -107,6 +110,13 @@ class Outputs:
         self.readouts = compute_readouts(model, q, L, self.ee_error, self.reaction, self.reaction_t)
 
 
+def deflection(q: np.ndarray, m: int) -> float:
+    """The base deflection plotted, m: x_b of a 1-DOF base, else the length of its (first three) translations."""
+    return float(q[0]) if m == 1 else float(np.sqrt(q[: min(m, 3)] @ q[: min(m, 3)]))
+
+
 def L_of(out: ControlOutput) -> float:
-    """The coupling momentum's first selected row, kg m/s (Eq. 8)."""
-    return float(out.coupling_momentum[0])
+    """The coupling momentum plotted (Eq. 8), kg m/s: the selected row of a one-row S, else the length of the
+    first three selected rows (the linear momentum when the translations are selected)."""
+    L = out.coupling_momentum
+    return float(L[0]) if len(L) == 1 else float(np.sqrt(L[:3] @ L[:3]))

@@ -63,6 +63,7 @@ def compute_readouts(
         warn_jbar=warn_j,
         n=tuple(float(v) for v in null_vector(H)) if rns_dim == 1 else None,
         rns_dim=rns_dim,
+        base_dof=model.m,
         L=L,
         ee_error=ee_error,
         reaction=reaction,
