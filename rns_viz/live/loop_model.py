@@ -41,9 +41,10 @@ class LoopModel:
 MAX_TRACKING_ROWS = 3  # r <= 3: a 3-D end-effector target is tracked by Eq. (24) in the RNS
 
 
-def selection_key(model: FsmsModel, flags: tuple[bool, ...]) -> str:
-    """The model key of ``model`` with selection S = ``flags`` (Sec. III-B); InputRefused if the app cannot
-    operate that RNS: a 1-D RNS runs along reactionless paths, at most three selected rows track a target."""
+def selection_key(model: FsmsModel, flags: tuple[bool, ...]) -> tuple[str, str]:
+    """The model key of ``model`` with selection S = ``flags`` (Sec. III-B) and what to tell the operator;
+    InputRefused if the app cannot operate that RNS: a 1-D RNS runs along reactionless paths, at most three
+    selected rows track a target."""
     if len(flags) != model.m:
         raise InputRefused(f"{model.name} has {model.m} base coordinates; the selection has {len(flags)} flags")
     r = sum(bool(f) for f in flags)
@@ -56,4 +57,15 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...]) -> str:
             f"r = {r} leaves a {model.n - r}-D reaction null space that the app does not operate yet: select "
             f"{model.n - 1} (a 1-D RNS: reactionless paths) or at most {MAX_TRACKING_ROWS} (end-effector tracking)"
         )
-    return model_key(model_source(model.name), flags)
+    note = f"r = {r}: the reaction null space has dimension n − r = {model.n - r}. " + (
+        "The arm moves without reaction along its reactionless path (scrub ū or drag the handle)."
+        if model.n - r == 1
+        else "Drag the handle: the hand tracks it in 3-D by Eq. (24) without the selected reactions."
+    )
+    if r < model.m:
+        note += (
+            " The other base coordinates are left free: the arm's motion still excites them, and on a "
+            "coupled base (a cantilever couples sideways force and tilt) suppressing the selected modes "
+            "can pump the free ones: watch the base plot; switch suppression off if they grow."
+        )
+    return model_key(model_source(model.name), flags), note

@@ -253,9 +253,10 @@ class LiveState:
                 self.settings = Settings.defaults(name, st.shadow, st.speed)
                 self.start_live(name)
             case c.SetSelection(flags=flags):  # the same system with another S, at rest where the arm is
-                key = selection_key(self.model, flags)
+                key, note = selection_key(self.model, flags)
                 self.settings = replace(st, model=key, preset=None)
                 self.start_live(key, self.runs.theta.copy())
+                self.notify("Selection S", note, cmd.client, "warning" if not all(flags) else "info")
             case c.StartLesson(model=model, number=number):
                 lesson = LessonRun(model, number)
                 start = lesson.lesson.start
@@ -284,8 +285,7 @@ class LiveState:
     # ================================================================ steps
     def tick(self) -> bool:
         """One simulation step; False if the simulation stopped (diverged or left physical bounds)."""
-        runs, op = self.runs, self.operator
-        t = runs.t
+        runs, op, t = self.runs, self.operator, self.runs.t
         if op is not None:
             change = op.advance(t, runs.sim.dt)
             if change.joint_move_changed:
