@@ -4,25 +4,30 @@ Run on demand (Debian chromium needed for the browser scenario):
 
     python benchmarks/bench_app.py                     # TREP, 60 s per scenario
     python benchmarks/bench_app.py --model planar3r --seconds 20
+    python benchmarks/bench_app.py --model boom7 --only browser   # the 13-DOF spatial system
 
 The app runs in its own process (its CPU time is measured there, with time.process_time over all
 its threads); clients run in this process. Scenarios, each with the shadow run on:
 
 1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
-   its reactionless path; 3R: kicks) and the base is kicked every 5 s from the page's button;
+   its reactionless path; 3R, boom7: kicks) and the base is kicked every 5 s from the page's button
+   (boom7: sideways, along y, the direction control's default);
 2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
 
 Printed per scenario: real-time factor (target >= 0.99), scene update rate (frames sent, target
 >= 30 Hz) and as received by a client, plot update rate (target >= 10 Hz), server CPU as % of
-one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms).
+one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms), with
+the machine's load average (the figures are only as good as the machine was quiet) and whether the
+native closed-loop step runs.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -67,6 +72,7 @@ def serve(model: str) -> None:
             "latencies": s.latencies(),
             "ee": app.model.ee_position(snap.q[app.model.m :]).tolist(),
             "clients": len(app.server.get_clients()),
+            "native": "native C++ step" if s.state.runs.sim.native else "Python step",
         }
         s._latencies.clear()
         print(json.dumps(stats), file=out, flush=True)
@@ -122,6 +128,12 @@ def summarize(name: str, a: dict[str, Any], b: dict[str, Any], client_rates: tup
         scene_rx, plots_rx = client_rates
         print(f"  received by a client  {scene_rx:6.1f} Hz scene windows, {plots_rx:5.1f} Hz plot updates")
     print(f"  server CPU            {cpu:6.1f} % of one core (target <= 60)")
+    print(f"  load average          {load()}  (simulator {b['native']})")
+
+
+def load() -> str:
+    """The machine's 1, 5 and 15 minute load averages (what `uptime` prints)."""
+    return ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
 def kicker(ws: Any, uuid: str, stop: threading.Event, every: float = 5.0) -> None:
@@ -226,7 +238,7 @@ def scenario_latency(model: str, seconds: float) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", default="trep", choices=("trep", "planar3r"))
+    parser.add_argument("--model", default="trep", help="a bundled model (trep, planar3r, boom7) or a .toml file")
     parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
     parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
@@ -234,7 +246,8 @@ def main() -> None:
     if args.serve:
         serve(args.model)
         return
-    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario, 2 cores shared")
+    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario, {os.cpu_count()} cores")
+    print(f"load average at start: {load()}")
     if args.only in (None, "browser"):
         scenario_browser(args.model, args.seconds)
     if args.only in (None, "clients"):

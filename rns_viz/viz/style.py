@@ -112,8 +112,8 @@ def style_for(model: FsmsModel) -> SceneStyle:
     if model_source(model.name) == "boom7":
         return SceneStyle(
             base=BoomStyle(),
-            camera_position=(6.2, -2.6, 1.9),
-            camera_look_at=(3.6, 0.0, 0.35),
+            camera_position=(5.4, -1.7, 1.25),
+            camera_look_at=(3.95, 0.0, 0.35),
             grid_z=-0.6,
             grid_size=12.0,
             grid_cell=0.25,
