@@ -308,6 +308,7 @@ DUAL_SCENARIOS: dict[str, Scenario] = {
     )
 }
 ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}
+LIVE_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS}  # the presets the live app offers
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:

@@ -85,7 +85,7 @@ def test_the_dropdown_switches_among_bundled_models_and_a_file_and_every_client_
         wait_until(lambda before=before: watcher.messages > before, 10.0, "the watcher to get updates")
         assert app.render_thread.is_alive() and not watcher.closed.is_set() and not operator.closed.is_set()
         panel: BasePanel = app.base_panel
-        wait_until(lambda m=m: panel.folder.visible == (m > 1), 10.0, "the base panel to show for a 6-DOF base")
+        wait_until(lambda m=m, p=panel: p.folder.visible == (m > 1), 10.0, "the base panel (6-DOF bases only)")
     theta = app.session.state.model.spec.default_configuration
     assert np.all(np.isfinite(app.session.snapshot().q)) and len(theta) == 7
 
@@ -98,9 +98,9 @@ def test_a_bad_model_file_is_refused_naming_the_element_and_the_app_keeps_its_mo
     path.write_text(path.read_text().replace("stiffness = [[100.0]]", "stiffness = [[100.0, 1.0]]"))
     choose(app, operator, "file: my_arm.toml")
     wait_until(lambda: any("stiffness" in body for _, _, body in told), 10.0, "the refusal to reach the operator")
-    client, title, body = next(t for t in told if "stiffness" in t[2])
+    client, _, body = next(t for t in told if "stiffness" in t[2])
     assert "my_arm.toml" in body and "[base] stiffness" in body and "shape" in body
-    assert client == operator_id(app)
+    assert client == app.lock.operator  # told to the client who asked
     snap = app.session.snapshot()
     assert snap.settings.model == "trep" and snap.t > 0.5 and np.allclose(snap.q[1:], q_before[1:], atol=0.1)
     wait_until(lambda: app.gui.model.value == MODEL_LABELS["trep"], 10.0, "the dropdown to show TREP again")
@@ -108,10 +108,6 @@ def test_a_bad_model_file_is_refused_naming_the_element_and_the_app_keeps_its_mo
     app.session.advance(0.2)  # the simulation runs on and the watcher is served
     wait_until(lambda: watcher.messages > before, 10.0, "the watcher to get updates")
     assert app.render_thread.is_alive() and app.model_name == "trep"
-
-
-def operator_id(app: RnsApp) -> int | None:
-    return app.lock.operator
 
 
 def test_serve_refuses_a_bad_model_file_naming_the_element(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:

@@ -16,7 +16,7 @@ from rns_viz.live import jobs
 from rns_viz.live.path_table import PathTable
 from rns_viz.live.reach import ReachRegion
 from rns_viz.live.worker import Worker
-from rns_viz.scenarios import SCENARIOS
+from rns_viz.scenarios import LIVE_SCENARIOS
 from rns_viz.sim import Simulator
 
 FAMILY_SIZE = 24  # curves of the Fig. 8 path family drawn
@@ -55,7 +55,7 @@ Ready = FamilyReady | TableReady | ReachReady | PresetReady | JobFailed
 
 
 def _build_preset(name: str) -> tuple[Simulator, Simulator]:
-    scenario = SCENARIOS[name]
+    scenario = LIVE_SCENARIOS[name]
     return scenario.build(), scenario.build()
 
 

@@ -21,7 +21,7 @@ from rns_viz.control import Gains, InvalidGain, LawKind
 from rns_viz.live.lessons import LESSONS
 from rns_viz.live.pacing import SPEEDS
 from rns_viz.params import check_model_key
-from rns_viz.scenarios import SCENARIOS
+from rns_viz.scenarios import LIVE_SCENARIOS
 
 LIVE_LAWS: tuple[LawKind, ...] = ("acceleration", "torque", "velocity")
 MAX_KICK_N = 1e4  # N: larger peaks are refused as input errors, not physics
@@ -233,8 +233,8 @@ class LoadPreset(Command):
     paused: bool = False  # adopt it paused at t = 0 (the operator resumes once the plots are in view)
 
     def __post_init__(self) -> None:
-        if self.name not in SCENARIOS:
-            raise ValueError(f"unknown preset {self.name!r}; choose one of {', '.join(SCENARIOS)}")
+        if self.name not in LIVE_SCENARIOS:
+            raise ValueError(f"unknown preset {self.name!r}; choose one of {', '.join(LIVE_SCENARIOS)}")
 
 
 @dataclass(frozen=True)

@@ -10,11 +10,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from rns_viz.live.guard import Bounds
 from rns_viz.live.operator import InputRefused
 from rns_viz.live.readouts import arm_reach
 from rns_viz.model import FsmsModel
-from rns_viz.params import model_key, model_source
+from rns_viz.params import model_key, model_source, spec_for_key
 from rns_viz.paths import CouplingField
 
 
@@ -36,6 +38,15 @@ class LoopModel:
     def copy_model(self) -> FsmsModel:
         """Another instance of the same (already checked) model, with its own pinocchio data."""
         return FsmsModel(self.model.spec)
+
+
+def key_of(model: FsmsModel) -> str:
+    """The model key of a model built elsewhere (a preset's): its source, with its S if not the file's own."""
+    source = model_source(model.name)
+    flags = model.spec.base.selection
+    if np.array_equal(spec_for_key(source).base.selection, flags):
+        return source
+    return model_key(source, [int(f) for f in flags])
 
 
 MAX_TRACKING_ROWS = 3  # r <= 3: a 3-D end-effector target is tracked by Eq. (24) in the RNS

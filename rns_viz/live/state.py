@@ -23,7 +23,7 @@ from rns_viz.live.geometry import Geometry
 from rns_viz.live.guard import GUARD_EVERY
 from rns_viz.live.kicks import kick_pulse
 from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun, run_view
-from rns_viz.live.loop_model import LoopModel, selection_key
+from rns_viz.live.loop_model import LoopModel, key_of, selection_key
 from rns_viz.live.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
@@ -32,7 +32,7 @@ from rns_viz.live.records import Level, Notice, Settings, Snapshot
 from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
-from rns_viz.scenarios import SCENARIOS
+from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
 
@@ -128,7 +128,7 @@ class LiveState:
         self._request_geometry(theta)
 
     def _adopt_preset(self, name: str, runs: RunPair) -> None:
-        self._use_model(SCENARIOS[name].model)
+        self._use_model(key_of(runs.model))  # the preset's model with its own S (boom7-track: forces only)
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
@@ -269,7 +269,7 @@ class LiveState:
             case c.LoadPreset(name=name, paused=paused):
                 self._preset_paused = paused
                 self.background.preset(self.epoch, name)
-                self.notify("Loading preset", f"{name}: {SCENARIOS[name].description}", cmd.client, "info")
+                self.notify("Loading preset", f"{name}: {LIVE_SCENARIOS[name].description}", cmd.client, "info")
             case _:
                 raise TypeError(f"unknown command {cmd!r}")
 

@@ -17,13 +17,14 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
-from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, SCENARIOS
+from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS
 from rns_viz.viz.live_plots import LivePlots
 from rns_viz.viz.model_menu import ModelMenu
 
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
 PLANAR3R_PRESETS = ("fig3", "fig4")
+BOOM7_PRESETS = ("boom7-kick-on", "boom7-kick-off", "boom7-path", "boom7-track", "boom7-p2p")
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
@@ -95,6 +96,7 @@ class GuiElements:
     gains: dict[str, viser.GuiSliderHandle]
     presets_trep: viser.GuiButtonGroupHandle
     presets_3r: viser.GuiButtonGroupHandle
+    presets_boom7: viser.GuiButtonGroupHandle
     preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
@@ -150,6 +152,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         hint = "One click loads an experiment's law, gains, motion and kicks (and its model)."
         presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=hint)
         presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=hint)
+        presets_boom7 = gui.add_button_group("Boom (3-D)", BOOM7_PRESETS, hint=hint)
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
@@ -290,6 +293,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         gains=gains,
         presets_trep=presets_trep,
         presets_3r=presets_3r,
+        presets_boom7=presets_boom7,
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
@@ -303,4 +307,4 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**{name}**: {SCENARIOS[name].description}. Reset restarts it."
+    return f"**{name}**: {LIVE_SCENARIOS[name].description}. Reset restarts it."
