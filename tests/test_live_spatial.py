@@ -70,6 +70,8 @@ def test_forces_only_tracks_a_3d_target_and_an_unserved_selection_is_refused(boo
     s.advance(0.01)
     told = [n for n in s.pop_notices() if n.title == "Selection S"]
     assert told and "n − r = 4" in told[0].body and "left free" in told[0].body
+    # forces only: the rows are the linear momentum, the gradient of M x_cm (Eq. 26), so the RNS is integrable
+    assert "the RNS distribution is integrable" in told[0].body
     snap = s.snapshot()
     assert snap.settings.model == "boom7#S=111000" and snap.readouts.rns_dim == 4 and len(snap.target) == 3  # type: ignore[arg-type]
     goal = np.asarray(snap.target) + np.array([0.03, -0.02, 0.02])

@@ -18,6 +18,7 @@ from rns_viz.live.readouts import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_key, model_source, spec_for_key
 from rns_viz.paths import CouplingField
+from rns_viz.rns import check_integrability
 
 
 @dataclass(frozen=True)
@@ -49,11 +50,23 @@ def key_of(model: FsmsModel) -> str:
     return model_key(source, [int(f) for f in flags])
 
 
+def integrability_note(model: FsmsModel, theta: np.ndarray) -> str:
+    """Frobenius test of the RNS distribution at ``theta`` (Lie brackets of the columns of P_RNS), in words."""
+    test = check_integrability(lambda th: model.coupling_matrix(model.q(th)), np.asarray(theta, dtype=float))
+    if test.integrable:
+        return f"Lie brackets here: the RNS distribution is integrable (residual {test.max_residual:.1e})."
+    return (
+        f"Lie brackets here: the RNS distribution is not integrable (residual {test.max_residual:.2g}): "
+        "reactionless motions can reach more than a fixed surface, as for a non-holonomic constraint."
+    )
+
+
 MAX_TRACKING_ROWS = 3  # r <= 3: a 3-D end-effector target is tracked by Eq. (24) in the RNS
 
 
-def selection_key(model: FsmsModel, flags: tuple[bool, ...]) -> tuple[str, str]:
-    """The model key of ``model`` with selection S = ``flags`` (Sec. III-B) and what to tell the operator;
+def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) -> tuple[str, str]:
+    """The model key of ``model`` with selection S = ``flags`` (Sec. III-B) and what to tell the operator
+    (for a multi-dimensional RNS, whether its distribution is integrable at ``theta``: Lie brackets, Sec. III-A);
     InputRefused if the app cannot operate that RNS: a 1-D RNS runs along reactionless paths, at most three
     selected rows track a target."""
     if len(flags) != model.m:
@@ -68,10 +81,12 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...]) -> tuple[str, str]:
             f"r = {r} leaves a {model.n - r}-D reaction null space that the app does not operate yet: select "
             f"{model.n - 1} (a 1-D RNS: reactionless paths) or at most {MAX_TRACKING_ROWS} (end-effector tracking)"
         )
+    selected = FsmsModel(model.spec.with_selection(flags))
     note = f"r = {r}: the reaction null space has dimension n − r = {model.n - r}. " + (
         "The arm moves without reaction along its reactionless path (scrub ū or drag the handle)."
         if model.n - r == 1
-        else "Drag the handle: the hand tracks it in 3-D by Eq. (24) without the selected reactions."
+        else "Drag the handle: the hand tracks it in 3-D by Eq. (24) without the selected reactions. "
+        + integrability_note(selected, theta)
     )
     if r < model.m:
         note += (
@@ -79,4 +94,4 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...]) -> tuple[str, str]:
             "coupled base (a cantilever couples sideways force and tilt) suppressing the selected modes "
             "can pump the free ones: watch the base plot; switch suppression off if they grow."
         )
-    return model_key(model_source(model.name), flags), note
+    return key_of(selected), note

@@ -253,7 +253,7 @@ class LiveState:
                 self.settings = Settings.defaults(name, st.shadow, st.speed)
                 self.start_live(name)
             case c.SetSelection(flags=flags):  # the same system with another S, at rest where the arm is
-                key, note = selection_key(self.model, flags)
+                key, note = selection_key(self.model, flags, self.runs.theta)
                 self.settings = replace(st, model=key, preset=None)
                 self.start_live(key, self.runs.theta.copy())
                 self.notify("Selection S", note, cmd.client, "warning" if not all(flags) else "info")
