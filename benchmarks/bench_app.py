@@ -10,8 +10,9 @@ The app runs in its own process (its CPU time is measured there, with time.proce
 its threads); clients run in this process. Scenarios, each with the shadow run on:
 
 1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
-   its reactionless path; 3R, boom7: kicks) and the base is kicked every 5 s from the page's button
-   (boom7: sideways, along y, the direction control's default);
+   its reactionless path; 3R: kicks; boom7: its r = 6 reactionless path played to the other end every
+   5 s) and the base is kicked every 5 s from the page's button (boom7: sideways, along y, the
+   direction control's default);
 2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
@@ -163,6 +164,8 @@ def scenario_browser(model: str, seconds: float) -> None:
             deadline = time.monotonic() + seconds
             while time.monotonic() < deadline:
                 page.get_by_role("button", name="Kick the base").click()
+                if model == "boom7":  # the arm moves too: along its reactionless path, to the other end and back
+                    page.get_by_role("button", name="Play path slowly (5 s)").click()
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
             b = srv.stats()
             browser.close()

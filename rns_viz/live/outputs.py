@@ -90,7 +90,7 @@ class Outputs:
         ref = reference_point(model, out)
         self.ee_error = float(np.linalg.norm(ref - x)) if ref is not None else math.nan
         shadow_out = shadow.last if shadow_on else None
-        coordinates = np.full(BASE_COORDINATES, math.nan)
+        coordinates = np.zeros(BASE_COORDINATES)
         coordinates[: model.m] = sim.q[: model.m] * 1e3
         self.plots.append(
             (
