@@ -129,6 +129,8 @@ def summarize(name: str, a: dict[str, Any], b: dict[str, Any], client_rates: tup
         scene_rx, plots_rx = client_rates
         print(f"  received by a client  {scene_rx:6.1f} Hz scene windows, {plots_rx:5.1f} Hz plot updates")
     print(f"  server CPU            {cpu:6.1f} % of one core (target <= 60)")
+    per_sim = (b["cpu"] - a["cpu"]) / max(b["sim_t"] - a["sim_t"], 1e-9)
+    print(f"  CPU per simulated s   {per_sim:6.3f} s (what real time costs on a free core: <= 0.6 meets the target)")
     print(f"  load average          {load()}  (simulator {b['native']})")
 
 
