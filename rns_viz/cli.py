@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rns_viz.params import MODEL_NAMES, ModelFileError
+from rns_viz.params import MODEL_NAMES, ModelFileError, model_key
 
 if TYPE_CHECKING:
     from rns_viz.model import FsmsModel
@@ -217,7 +217,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
         who = "" if gated else " and anyone may take control (no --password)"
         print(f"rns-viz: warning: binding {args.host}: other machines can reach this app{who}", file=sys.stderr)
     password = args.password or os.environ.get("RNS_VIZ_PASSWORD") or None
-    models = args.model or ["trep"]
+    models = [model_key(name) for name in args.model or ["trep"]]  # files by absolute path: one key each
     for name in models:  # every file is read and checked now: a bad one is refused before serving
         _load_model(name)
     model = models[0]
