@@ -6,21 +6,25 @@ Run on demand (Debian chromium needed for the browser scenario):
     python benchmarks/bench_app.py --model planar3r --seconds 20
     python benchmarks/bench_app.py --teach --seconds 70  # issue 11: teaching views and recording, vs off
     python benchmarks/bench_app.py --model trep2 --only browser     # dual arms (issue 13)
+    python benchmarks/bench_app.py --model boom7 --only browser   # the 13-DOF spatial system
 
 The app runs in its own process (its CPU time is measured there, with time.process_time over all
 its threads); clients run in this process. Scenarios, each with the shadow run on:
 
 1. one browser (Playwright + Debian chromium) connected; the arm moves (TREP: cyclic motion along
    its reactionless path; 3R: kicks; trep2: the task arm's target jumps between two points 5 cm
-   apart every 2.5 s, server side, the compensator cancelling, the shadow's held) and the base is
-   kicked every 5 s from the page's button;
+   apart every 2.5 s, server side, the compensator cancelling, the shadow's held; boom7: its r = 6
+   reactionless path played to the other end every 5 s) and the base is kicked every 5 s from the
+   page's button (boom7: sideways, along y, the direction control's default);
 2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
 
 Printed per scenario: real-time factor (target >= 0.99), scene update rate (frames sent, target
 >= 30 Hz) and as received by a client, plot update rate (target >= 10 Hz), server CPU as % of
-one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms).
+one core (target <= 60 %), and the latency median / 90th percentile (target median <= 5 ms), with
+the machine's load average (the figures are only as good as the machine was quiet) and whether the
+native closed-loop step runs.
 
 ``--teach`` (issue 11) runs the one-browser scenario twice in the same run: first a baseline with
 every *Show in the scene* view off (no ghost, no arrows, trail or region) and the recorder switched
@@ -28,7 +32,6 @@ off, then with all of them on and the recorder recording (as the app always does
 the figures above and the server's resident memory; then the ring buffer's size for 60 s, the memory
 it added over the baseline, and the memory a 60 s replay takes (the immutable copy it replays).
 Use ``--seconds 60`` or more so the ring has filled once.
-The machine's load average is printed before and after: figures from a loaded machine are not the app's.
 """
 
 from __future__ import annotations
@@ -109,6 +112,7 @@ def serve(model: str, teach: str | None = None) -> None:
             "rss_mb": rss_mb(),
             "ring_mb": recorder.nbytes() / 1e6,
             "recorded_s": len(recorder) * s.dt,
+            "native": "native C++ step" if s.state.runs.sim.native else "Python step",
         }
         s._latencies.clear()
         print(json.dumps(stats), file=out, flush=True)
@@ -183,6 +187,14 @@ def summarize(name: str, a: dict[str, Any], b: dict[str, Any], client_rates: tup
         print(f"  received by a client  {scene_rx:6.1f} Hz scene windows, {plots_rx:5.1f} Hz plot updates")
     print(f"  server CPU            {cpu:6.1f} % of one core (target <= 60)")
     print(f"  server memory         {b['rss_mb']:6.1f} MB resident; recorded {b['recorded_s']:.1f} s")
+    per_sim = (b["cpu"] - a["cpu"]) / max(b["sim_t"] - a["sim_t"], 1e-9)
+    print(f"  CPU per simulated s   {per_sim:6.3f} s (what real time costs on a free core: <= 0.6 meets the target)")
+    print(f"  load average          {load()}  (simulator {b['native']})")
+
+
+def load() -> str:
+    """The machine's 1, 5 and 15 minute load averages (what `uptime` prints)."""
+    return ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
 def kicker(ws: Any, uuid: str, stop: threading.Event, every: float = 5.0) -> None:
@@ -212,6 +224,8 @@ def scenario_browser(model: str, seconds: float, teach: str | None = None) -> di
             deadline = time.monotonic() + seconds
             while time.monotonic() < deadline:
                 page.get_by_role("button", name="Kick the base").click()
+                if model == "boom7":  # the arm moves too: along its reactionless path, to the other end and back
+                    page.get_by_role("button", name="Play path slowly (5 s)").click()
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
             b = srv.ask()
             if teach == "on":
@@ -303,7 +317,7 @@ def scenario_latency(model: str, seconds: float) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", default="trep", choices=("trep", "planar3r", "trep2"))
+    parser.add_argument("--model", default="trep", help="a bundled model (trep, planar3r, boom7, trep2) or .toml file")
     parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
     parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
     parser.add_argument("--teach", action="store_true", help="issue 11: one browser, teaching views off then on")
@@ -313,11 +327,11 @@ def main() -> None:
     if args.serve:
         serve(args.model, args.teach_mode)
         return
-    load = Path("/proc/loadavg").read_text().split()[:3]
-    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario; load {' '.join(load)}")
+    print(f"rns_viz live app benchmark: model {args.model}, {args.seconds:g} s per scenario, {os.cpu_count()} cores")
+    print(f"load average at start: {load()}")
     if args.teach:
         scenario_teach(args.model, args.seconds)
-        print(f"\nload average after: {' '.join(Path('/proc/loadavg').read_text().split()[:3])}")
+        print(f"\nload average after: {load()}")
         return
     if args.only in (None, "browser"):
         scenario_browser(args.model, args.seconds)

@@ -16,11 +16,15 @@ from rns_viz.control import AccelerationLaw
 from rns_viz.model import FsmsModel
 
 DT = 1e-3
-X_B0 = {"trep": 2e-3, "planar3r": 1e-2, "arm7": 1e-2}  # initial base deflection, m
+X_B0 = {"trep": 2e-3, "planar3r": 1e-2, "arm7": 1e-2, "boom7": 1e-3}  # initial base deflection, m
 
 
 def initial_state(model: FsmsModel) -> tuple[np.ndarray, np.ndarray]:
-    return model.q(model.spec.default_configuration, [X_B0[model.name]]), np.zeros(model.nv)
+    """At rest at the default configuration, the base deflected along its first lateral coordinate
+    (boom7: sideways, y; the others: their one coordinate)."""
+    x_b = np.zeros(model.m)
+    x_b[1 if model.m > 1 else 0] = X_B0[model.name]
+    return model.q(model.spec.default_configuration, x_b), np.zeros(model.nv)
 
 
 # -- a 7-DOF spatial arm on a translating elastic base, generated -----------------------------------

@@ -16,12 +16,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rns_viz.params import MODEL_NAMES, ModelFileError
+from rns_viz.params import MODEL_NAMES, ModelFileError, model_key
 
 if TYPE_CHECKING:
     from rns_viz.model import FsmsModel
 
-MODEL_HELP = "trep, planar3r, or a model's parameter file (.toml)"
+MODEL_HELP = "trep, planar3r, boom7 (bundled), or a model's parameter file (.toml)"
 
 
 class CliError(Exception):
@@ -217,13 +217,20 @@ def cmd_serve(args: argparse.Namespace) -> None:
         who = "" if gated else " and anyone may take control (no --password)"
         print(f"rns-viz: warning: binding {args.host}: other machines can reach this app{who}", file=sys.stderr)
     password = args.password or os.environ.get("RNS_VIZ_PASSWORD") or None
+    models = [model_key(name) for name in args.model or ["trep"]]  # files by absolute path: one key each
+    for name in models:  # every file is read and checked now: a bad one is refused before serving
+        _load_model(name)
+    model = models[0]
     if args.lesson is not None:
         from rns_viz.live.lessons import LESSONS
 
-        count = len(LESSONS[args.model])
+        if model not in LESSONS:
+            raise CliError(f"{model} has no lessons; there are some for {', '.join(LESSONS)}")
+        count = len(LESSONS[model])
         if args.lesson > count:
-            raise CliError(f"{args.model} has lessons 1 to {count}, not {args.lesson}")
-    serve(model=args.model, host=args.host, port=args.port, password=password, lesson=args.lesson)
+            raise CliError(f"{model} has lessons 1 to {count}, not {args.lesson}")
+    extra = [name for name in models if name.endswith(".toml")]
+    serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -270,7 +277,12 @@ def build_parser() -> argparse.ArgumentParser:
     figures.add_argument("--only", nargs="*", help="a subset of the figures")
     figures.set_defaults(func=cmd_figures)
     serve = sub.add_parser("serve", help="start the browser app (the default command)")
-    serve.add_argument("--model", choices=MODEL_NAMES, default="trep")
+    serve.add_argument(
+        "--model",
+        type=_model_arg,
+        action="append",
+        help=MODEL_HELP + "; the first is served, every file joins the model dropdown (repeat to add more)",
+    )
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")

@@ -25,7 +25,7 @@ at 0.1 m/s (half the task arm's reach per second): the compensator, about 1.1 ti
 task arm to cancel it, then turns at 1-2 rad/s, far below its joints' URDF velocity limits
 (20 rad/s), above which the app says the compensator is asked too much.
 
-boom7 (the spatial model; not yet served by the app): law (15) with g_b = 10, G_m = 2 on all six
+boom7 (the spatial model): law (15) with g_b = 10, G_m = 2 on all six
 tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
 about 1.3 mm of a 4 m boom, drawn 50x). Its kick needs a direction: along the first base
 coordinate alone it would push the stiff axial mode (170 Hz, 1e-7 m).
@@ -36,6 +36,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rns_viz.control import Gains, LawKind
+from rns_viz.params import model_source
 
 
 @dataclass(frozen=True)
@@ -101,5 +102,5 @@ GENERIC_DEFAULTS = ModelDefaults(law="acceleration")
 
 
 def defaults_for(model: str) -> ModelDefaults:
-    """The defaults of a bundled model; a model from a parameter file gets generic ones."""
-    return MODEL_DEFAULTS.get(model, GENERIC_DEFAULTS)
+    """The defaults of a bundled model (by name or model key); a model from a parameter file gets generic ones."""
+    return MODEL_DEFAULTS.get(model_source(model), GENERIC_DEFAULTS)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from rns_viz.params import ModelFileError, ModelSpec, load_spec, param_path_for
+from rns_viz.params import ModelFileError, ModelSpec, load_spec, param_path_for, spec_for_key
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -115,6 +115,11 @@ class FsmsModel:
     def from_name(cls, name: str) -> FsmsModel:
         """A bundled model: ``trep``, ``planar3r`` or ``boom7``."""
         return cls(load_spec(param_path_for(name)))
+
+    @classmethod
+    def from_key(cls, key: str) -> FsmsModel:
+        """The model a key of :func:`rns_viz.params.model_key` names (bundled or a file, with its S)."""
+        return cls(spec_for_key(key))
 
     def with_selection(self, selection: Sequence[int | bool]) -> FsmsModel:
         """The same system with another selection S: 0/1 flags over the base coordinates (Sec. III-B)."""

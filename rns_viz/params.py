@@ -21,8 +21,9 @@ from pathlib import Path
 import numpy as np
 
 ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
-MODEL_NAMES = ("trep", "planar3r", "trep2")  # the models the live app serves
-BUNDLED_MODELS = (*MODEL_NAMES, "boom7")  # every model in assets/, for FsmsModel.from_name
+MODEL_NAMES = ("trep", "planar3r", "boom7", "trep2")  # the bundled models the live app serves: one line per model
+BUNDLED_MODELS = MODEL_NAMES  # every model in assets/, for FsmsModel.from_name
+SELECTION_MARK = "#S="  # a model key's selection suffix: "boom7#S=111000"
 TASK_AXES = ("x", "y", "z")
 
 
@@ -80,6 +81,53 @@ class ModelSpec:
                 f"{self.name}: a selection needs {m} flags of 0 or 1, at least one 1; got {selection!r}"
             )
         return replace(self, base=replace(self.base, selection=flags.astype(bool)))
+
+
+def model_key(source: str, selection: Sequence[int | bool] | None = None) -> str:
+    """The one string that names a live model: a bundled name or a parameter file's absolute path,
+    with ``#S=`` and the 0/1 flags of S when S is not the file's own (Sec. III-B)."""
+    source = model_source(source)
+    if source not in BUNDLED_MODELS:
+        source = str(Path(source).resolve())
+    if selection is None:
+        return source
+    return source + SELECTION_MARK + "".join("1" if flag else "0" for flag in selection)
+
+
+def model_source(key: str) -> str:
+    """The bundled name or parameter file of a model key (its selection suffix removed)."""
+    return key.split(SELECTION_MARK, 1)[0]
+
+
+def key_selection(key: str) -> tuple[int, ...] | None:
+    """The selection flags a model key carries, or None (the parameter file's own S)."""
+    if SELECTION_MARK not in key:
+        return None
+    flags = key.split(SELECTION_MARK, 1)[1]
+    if not flags or any(f not in "01" for f in flags):
+        raise ModelFileError(f"{key!r}: a selection is written as 0/1 flags, e.g. #S=111000")
+    return tuple(int(f) for f in flags)
+
+
+def check_model_key(key: object) -> str:
+    """A model key's form (a bundled name, or a .toml file, optionally with #S=...); the file is read later."""
+    if not isinstance(key, str) or not key:
+        raise ModelFileError(f"a model is a bundled name or a .toml parameter file, got {key!r}")
+    source = model_source(key)
+    if source not in BUNDLED_MODELS and not source.endswith(".toml"):
+        raise ModelFileError(f"unknown model {source!r}; choose one of {', '.join(MODEL_NAMES)} or a .toml file")
+    key_selection(key)
+    return key
+
+
+def spec_for_key(key: str) -> ModelSpec:
+    """Read and check the model a key names; the spec's name is the key (caches and jobs use it)."""
+    source = model_source(check_model_key(key))
+    spec = load_spec(param_path_for(source) if source in BUNDLED_MODELS else source)
+    flags = key_selection(key)
+    if flags is not None:
+        spec = spec.with_selection(flags)
+    return replace(spec, name=key)
 
 
 def param_path_for(name: str) -> Path:

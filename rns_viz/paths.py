@@ -95,8 +95,14 @@ class CouplingField:
         return com @ self.scaled_axes.T
 
     def project(self, thetas: np.ndarray, levels: np.ndarray, newton_steps: int = 3) -> np.ndarray:
-        """Move each configuration onto its level set c(theta) = level along H_bm (min-norm Newton)."""
+        """Move each configuration onto its level set c(theta) = level along H_bm (min-norm Newton).
+
+        A base that turns has no potential of its angular rows (angular momentum is not a gradient):
+        the configurations are returned unchanged, the integration alone keeps them on the path.
+        """
         thetas = thetas.copy()
+        if not self.translational:
+            return thetas
         for _ in range(newton_steps):
             H, pot = self.rows_at(thetas, want_potential=True)
             thetas -= _right_inverse_times(H, pot - levels)

@@ -9,6 +9,7 @@ import math
 import operator
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
@@ -166,8 +167,18 @@ def null_vector(H_bm: np.ndarray) -> np.ndarray:
         raise ValueError(f"null_vector needs an m x (m+1) matrix for a 1-D RNS, got {H.shape}")
     if rows == 1:
         return np.stack([H[..., 0, 1], -H[..., 0, 0]], axis=-1)
-    minors = [np.linalg.det(np.delete(H, i, axis=-1)) for i in range(cols)]
-    return np.stack([minor if i % 2 == 0 else -minor for i, minor in enumerate(minors)], axis=-1)
+    # all m + 1 minors in one batched determinant: (..., m + 1, m, m), column i left out of minor i
+    minors = np.linalg.det(np.swapaxes(H[..., _minor_columns(cols)], -3, -2))
+    return minors * _ALTERNATING[:cols]
+
+
+_ALTERNATING = np.array([1.0, -1.0] * 4)  # (-1)^i for up to 7 columns (m <= 6)
+
+
+@cache
+def _minor_columns(cols: int) -> np.ndarray:
+    """(cols, cols - 1) column indices: row i lists every column but i."""
+    return np.array([[j for j in range(cols) if j != i] for i in range(cols)])
 
 
 def restricted_jacobian(J: np.ndarray, P_rns: np.ndarray) -> np.ndarray:

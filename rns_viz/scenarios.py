@@ -309,7 +309,7 @@ DUAL_SCENARIOS: dict[str, Scenario] = {
     )
 }
 ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}
-LIVE_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **DUAL_SCENARIOS}  # the presets the live app offers
+LIVE_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}  # the app's presets
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:

@@ -41,18 +41,21 @@ values = numbers | st.sampled_from(WRONG)
 positions = st.tuples(numbers, numbers, numbers)
 
 
-def controls(gui: GuiElements) -> list[Any]:
-    """Every input control of the panel, from the GuiElements fields (gain sliders included)."""
+def controls(gui: GuiElements, app: RnsApp | None = None) -> list[Any]:
+    """Every input control of the panel, from the GuiElements fields (gain sliders included), and the base
+    panel's (kick direction, selection S; hidden for a 1-DOF base, but a client can still send to them)."""
     out: list[Any] = []
     for f in fields(gui):
         value = getattr(gui, f.name)
         for handle in value.values() if isinstance(value, dict) else [value]:
             if isinstance(handle, INPUT_TYPES):
                 out.append(handle)
+    if app is not None:
+        out += [app.base_panel.direction, *app.base_panel.boxes]
     return out
 
 
-@pytest.fixture(scope="module", params=["trep", "planar3r"])
+@pytest.fixture(scope="module", params=["trep", "planar3r", "boom7"])
 def hostile_app(request: pytest.FixtureRequest) -> Iterator[tuple[RnsApp, ProtocolClient, ProtocolClient]]:
     app = start_app(request.param, port=0, realtime=False, verbose=False)
     assert app.session.wait_background()
@@ -111,7 +114,7 @@ def test_hostile_values_to_every_control(
 ) -> None:
     app, operator, watcher = hostile_app
     s = app.session
-    handles = controls(app.gui)
+    handles = controls(app.gui, app)
     for via, index, value, position in batch:
         handle = handles[index % len(handles)]
         if via == "server":

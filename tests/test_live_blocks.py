@@ -47,6 +47,13 @@ DT = 1e-3
         lambda: c.SetSuppression("yes"),
         lambda: c.SingleStep(0),
         lambda: c.SwitchModel("nope"),
+        lambda: c.SwitchModel("boom7#S=12"),
+        lambda: c.SetSelection(()),
+        lambda: c.SetSelection((1, 0)),
+        lambda: c.Kick(1.0, (0.0, 0.0)),
+        lambda: c.Kick(1.0, (2.0,)),
+        lambda: c.Kick(1.0, (math.nan,)),
+        lambda: c.DragTarget((0.0, 0.0, 0.0, 0.0)),
         lambda: c.LoadPreset("nope"),
     ],
 )

@@ -75,8 +75,8 @@ def test_boom_stiffness_is_the_cantilever_tip_stiffness(boom7: FsmsModel) -> Non
     assert np.allclose(boom7.D_b, boom7.D_b[0, 0] / boom7.K_b[0, 0] * boom7.K_b, rtol=1e-5, atol=0)
 
 
-def test_boom7_is_bundled_but_not_yet_served(boom7: FsmsModel) -> None:
-    assert "boom7" in BUNDLED_MODELS and "boom7" not in MODEL_NAMES
+def test_boom7_is_bundled_and_served(boom7: FsmsModel) -> None:
+    assert "boom7" in BUNDLED_MODELS and "boom7" in MODEL_NAMES
     assert (boom7.m, boom7.n, boom7.nv) == (6, 7, 13)
     assert not np.any(boom7.spec.gravity)
     assert boom7.arm_mass == pytest.approx(16.792132)  # links 1-7 and hand, kg (link 0 is part of the tip)

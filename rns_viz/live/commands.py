@@ -21,7 +21,7 @@ from rns_viz.control import Gains, InvalidGain, LawKind
 from rns_viz.live.lessons import LESSONS
 from rns_viz.live.pacing import SPEEDS
 from rns_viz.live.recorder import MAX_RECORD_S
-from rns_viz.params import MODEL_NAMES
+from rns_viz.params import check_model_key
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 LIVE_LAWS: tuple[LawKind, ...] = ("acceleration", "torque", "velocity")
@@ -85,11 +85,22 @@ class SetSpeed(Command):
 
 @dataclass(frozen=True)
 class Kick(Command):
-    peak: float  # N, half-sine peak along the base's first coordinate
+    peak: float  # N (N m on a rotational coordinate), half-sine peak
+    direction: tuple[float, ...] | None = None  # weights over the base coordinates (None: the first alone)
 
     def __post_init__(self) -> None:
         if abs(_finite("kick peak", self.peak)) > MAX_KICK_N:
             raise ValueError(f"kick peak must be a force of at most {MAX_KICK_N:g} N, got {self.peak}")
+        if self.direction is not None:
+            try:
+                weights = np.asarray(self.direction, dtype=float).reshape(-1)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"kick direction must be numbers, got {self.direction!r}") from exc
+            if not 1 <= weights.size <= 6 or not np.all(np.isfinite(weights)) or float(np.max(np.abs(weights))) > 1:
+                raise ValueError(f"kick direction must be 1 to 6 weights within [-1, 1], got {self.direction!r}")
+            if not np.any(weights):
+                raise ValueError("kick direction must not be all zero")
+            object.__setattr__(self, "direction", tuple(float(w) for w in weights))
 
 
 @dataclass(frozen=True)
@@ -154,18 +165,18 @@ class SetShadow(Command):
 
 @dataclass(frozen=True)
 class DragTarget(Command):
-    xy: tuple[float, float]  # m, base frame
+    xy: tuple[float, ...]  # m, base frame: (x, y) in the task plane of a planar model, (x, y, z) in space
     final: bool = False  # the end of a drag
 
     def __post_init__(self) -> None:
         try:
-            xy = np.asarray(self.xy, dtype=float).reshape(-1)[:2]
+            xy = np.asarray(self.xy, dtype=float).reshape(-1)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"target must be two numbers (m), got {self.xy!r}") from exc
-        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or float(np.max(np.abs(xy))) > MAX_TARGET_M:
-            raise ValueError(f"target must be two finite coordinates within {MAX_TARGET_M:g} m, got {self.xy!r}")
+            raise ValueError(f"target must be two or three numbers (m), got {self.xy!r}") from exc
+        if xy.size not in (2, 3) or not np.all(np.isfinite(xy)) or float(np.max(np.abs(xy))) > MAX_TARGET_M:
+            raise ValueError(f"target must be 2 or 3 finite coordinates within {MAX_TARGET_M:g} m, got {self.xy!r}")
         _switch("end of drag", self.final)
-        object.__setattr__(self, "xy", (float(xy[0]), float(xy[1])))
+        object.__setattr__(self, "xy", tuple(float(v) for v in xy))
 
 
 @dataclass(frozen=True)
@@ -200,11 +211,22 @@ class PointToPoint(Command):
 
 @dataclass(frozen=True)
 class SwitchModel(Command):
-    model: str
+    model: str  # a model key: a bundled name or a .toml parameter file (read, and refused if bad, by the loop)
 
     def __post_init__(self) -> None:
-        if self.model not in MODEL_NAMES:
-            raise ValueError(f"unknown model {self.model!r}; choose one of {', '.join(MODEL_NAMES)}")
+        check_model_key(self.model)
+
+
+@dataclass(frozen=True)
+class SetSelection(Command):
+    flags: tuple[bool, ...]  # S (Sec. III-B): per base coordinate, True = its reaction must vanish
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.flags, tuple | list) or not 1 <= len(self.flags) <= 6:
+            raise ValueError(f"a selection is 1 to 6 on/off flags, got {self.flags!r}")
+        for flag in self.flags:
+            _switch("a selection flag", flag)
+        object.__setattr__(self, "flags", tuple(bool(f) for f in self.flags))
 
 
 @dataclass(frozen=True)
@@ -294,4 +316,5 @@ TIMED = (
     Play,
     Cyclic,
     PointToPoint,
+    SetSelection,
 )

@@ -27,7 +27,6 @@ from rns_viz.analysis import (
     Modes,
     authority,
     fit_decay,
-    map_of,
     modes_of,
     root_locus,
 )
@@ -101,8 +100,8 @@ class GainExplorer:
             return
 
         def job() -> tuple[LinearLoop, GainMap, tuple[Modes, Locus, Locus]]:
-            loop = jobs.call("linear_loop", model, law, theta)
-            return loop, map_of(loop), _at(loop, gains)
+            loop, grid = jobs.call("loop_and_map", model, law, theta)
+            return loop, grid, _at(loop, gains)
 
         self.worker.submit("loop", key, job)
 

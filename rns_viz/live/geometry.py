@@ -40,7 +40,7 @@ class Geometry:
         if model.n - len(model.selected) == 1:
             self.background.path_table(epoch, model.name, theta, default)
             self.background.family(epoch, model.name)
-        else:
+        elif model.base_is_translational:  # the reachable set is explored on the potential's level set
             self.background.reach(epoch, model.name, theta)
 
     def took_table(self, model: str, table: PathTable, default: bool) -> None:

@@ -22,7 +22,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from rns_viz.analysis import LinearLoop, linearise, loops_along
+from rns_viz.analysis import GainMap, LinearLoop, linearise, loops_along, map_of
 from rns_viz.control import LawKind
 from rns_viz.live.path_table import PathTable, build_path_table
 from rns_viz.live.reach import ReachRegion, build_reach_region
@@ -34,7 +34,7 @@ _models: dict[str, FsmsModel] = {}
 
 def _model(name: str) -> FsmsModel:
     if name not in _models:
-        _models[name] = FsmsModel.from_name(name)
+        _models[name] = FsmsModel.from_key(name)
     return _models[name]
 
 
@@ -56,12 +56,19 @@ def linear_loop(name: str, law: LawKind, theta: np.ndarray) -> LinearLoop:
     return linearise(_model(name), law, theta)
 
 
+def loop_and_map(name: str, law: LawKind, theta: np.ndarray) -> tuple[LinearLoop, GainMap]:
+    """The linearised loop and its gain map (60 x 60 eigenproblems: seconds for boom7's 13 DOF, so here,
+    not in a thread of the app's process where it would take turns with the simulation for the GIL)."""
+    loop = linear_loop(name, law, theta)
+    return loop, map_of(loop)
+
+
 def linear_loops(name: str, law: LawKind, thetas: np.ndarray) -> list[LinearLoop]:
     """One linearised loop per configuration (the gain explorer's authority along a path)."""
     return loops_along(_model(name), law, thetas)
 
 
-JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region, linear_loop, linear_loops)}
+JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region, linear_loop, loop_and_map, linear_loops)}
 
 
 class JobError(RuntimeError):

@@ -43,8 +43,14 @@ class KickSchedule:
         return f
 
 
-def kick_pulse(t: float, peak: float, duration: float, m: int) -> ForcePulse:
-    """A pulse starting at ``t`` along the first base coordinate, N; raises ValueError for bad input."""
+def kick_pulse(
+    t: float, peak: float, duration: float, m: int, direction: tuple[float, ...] | None = None
+) -> ForcePulse:
+    """A pulse starting at ``t``, N (N m on rotational coordinates): ``peak`` times ``direction``'s weights
+    over the m base coordinates (None: along the first alone); raises ValueError for bad input."""
     if not np.isfinite(peak) or abs(peak) > MAX_KICK_N:
         raise ValueError(f"kick peak must be a finite force of at most {MAX_KICK_N:g} N, got {peak}")
-    return ForcePulse(start=t, duration=duration, peak=(float(peak),) + (0.0,) * (m - 1))
+    weights = (1.0,) + (0.0,) * (m - 1) if direction is None else tuple(direction)
+    if len(weights) != m:
+        raise ValueError(f"this model's base has {m} coordinates; the kick direction gives {len(weights)}")
+    return ForcePulse(start=t, duration=duration, peak=tuple(float(peak) * w for w in weights))

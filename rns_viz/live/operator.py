@@ -110,7 +110,8 @@ class Operator:
         return self.table.centred(self.motion.sigma)
 
     def _point(self, xy: np.ndarray) -> np.ndarray:
-        return np.array([xy[0], xy[1], self.ee_z])
+        """A base-frame point (m): (x, y) of a planar task at the end effector's height, or (x, y, z)."""
+        return np.array([xy[0], xy[1], xy[2] if len(xy) > 2 else self.ee_z], dtype=float)
 
     def set_speeds(self, ubar_speed: float, target_speed: float) -> None:
         if self.on_path:
@@ -170,8 +171,9 @@ class Operator:
             self.motion.go_to(goal)
             self.target = self._point(table.ee_at(goal))
             self.mode = "moving along the path to the target"
-            return bool(np.linalg.norm(self.target[:2] - point[:2]) > SNAP_TOLERANCE_M)
-        clamped, moved = (point[:2].copy(), False) if self.reach is None else self.reach.clamp(point)
+            k = len(point)  # the coordinates the operator gave: (x, y) in the plane, (x, y, z) in space
+            return bool(np.linalg.norm(self.target[:k] - point[:k]) > SNAP_TOLERANCE_M)
+        clamped, moved = (point[: len(self.rr.rows)].copy(), False) if self.reach is None else self.reach.clamp(point)
         self.rr.set_goal(clamped)
         self.target = self._point(clamped)
         self.mode = "tracking the target"
@@ -179,14 +181,14 @@ class Operator:
 
     def why_moved(self) -> str:
         """What to tell the operator when :meth:`drag` moved their target."""
-        x, y = self.target[:2]  # type: ignore[index]
+        point = ", ".join(f"{v:.2f}" for v in self.target[: len(self.model.task_rows)])  # type: ignore[index]
         if self.on_path:
             where = "The arm moves without reaction only along its current reactionless path"
         elif isinstance(self.rr, TaskTarget):
             where = "That target is outside the task arm's workspace"
         else:
             where = "That target is outside the set reachable without reaction from this configuration"
-        return f"{where}; it goes to the nearest point ({x:.2f}, {y:.2f}) m instead."
+        return f"{where}; it goes to the nearest point ({point}) m instead."
 
     def scrub(self, sigma: float) -> None:
         """Move along the path to the slider's sigma (centred for closed paths), rate-limited by u-bar."""

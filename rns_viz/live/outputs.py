@@ -15,7 +15,7 @@ import numpy as np
 
 from rns_viz.control import ControlOutput
 from rns_viz.live.dual import compensation_state, operated_is_better
-from rns_viz.live.plots import PlotBuffers
+from rns_viz.live.plots import BASE_COORDINATES, PlotBuffers
 from rns_viz.live.reaction import ReactionProbe
 from rns_viz.live.readouts import compute_readouts
 from rns_viz.live.recorder import Recorder
@@ -31,13 +31,13 @@ REACTION_EVERY = 4  # steps between evaluations of the arm's reaction (250 Hz: e
 
 
 def reference_point(model: FsmsModel, out: ControlOutput | None) -> np.ndarray | None:
-    """Where the law sends the end effector (base frame x, y, m), or None without a reference."""
+    """Where the law sends the end effector (base frame, m, the model's task axes), or None without a reference."""
     if out is None:
         return None
     if out.ee_ref is not None:
-        return np.asarray(out.ee_ref)[:2]
+        return np.asarray(out.ee_ref)[: len(model.task_rows)]
     if out.theta_ref is not None:
-        return model.ee_position(out.theta_ref)[:2]
+        return model.ee_position(out.theta_ref)[model.task_rows]
     return None
 
 
@@ -97,19 +97,22 @@ class Outputs:
         self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool, suppress: bool
     ) -> None:
         sim, shadow = runs.sim, runs.shadow
-        x = model.ee_position(sim.q[model.m :])[:2]
+        x = model.ee_position(sim.q[model.m :])[model.task_rows]
         ref = reference_point(model, out)
         self.ee_error = float(np.linalg.norm(ref - x)) if ref is not None else math.nan
         shadow_out = shadow.last if shadow_on else None
+        coordinates = np.zeros(BASE_COORDINATES)
+        coordinates[: model.m] = sim.q[: model.m] * 1e3
         self.plots.append(
             (
                 sim.t,
-                sim.q[0] * 1e3,
-                shadow.q[0] * 1e3 if shadow_on else math.nan,
+                deflection(sim.q, model.m) * 1e3,
+                deflection(shadow.q, model.m) * 1e3 if shadow_on else math.nan,
                 L_of(out),
                 L_of(shadow_out) if shadow_out is not None else math.nan,
                 self.ee_error * 1e3,
                 float(operated_is_better(sim.law, suppress)),
+                *coordinates,
             )
         )
 
@@ -133,6 +136,13 @@ class Outputs:
         self.readouts = readouts
 
 
+def deflection(q: np.ndarray, m: int) -> float:
+    """The base deflection plotted, m: x_b of a 1-DOF base, else the length of its (first three) translations."""
+    return float(q[0]) if m == 1 else float(np.sqrt(q[: min(m, 3)] @ q[: min(m, 3)]))
+
+
 def L_of(out: ControlOutput) -> float:
-    """The coupling momentum's first selected row, kg m/s (Eq. 8)."""
-    return float(out.coupling_momentum[0])
+    """The coupling momentum plotted (Eq. 8), kg m/s: the selected row of a one-row S, else the length of the
+    first three selected rows (the linear momentum when the translations are selected)."""
+    L = out.coupling_momentum
+    return float(L[0]) if len(L) == 1 else float(np.sqrt(L[:3] @ L[:3]))

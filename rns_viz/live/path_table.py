@@ -67,9 +67,10 @@ class PathTable:
         return np.array([np.interp(s, self.sigma, self.ee[:, i]) for i in range(3)])
 
     def sigma_nearest_point(self, point: np.ndarray) -> float:
-        """sigma of the path point whose end effector is nearest ``point`` (x, y[, z]) in the task plane."""
-        p = np.asarray(point, dtype=float)[:2]
-        a, b = self.ee[:-1, :2], self.ee[1:, :2]
+        """sigma of the path point whose end effector is nearest ``point``: (x, y) in the task plane, or (x, y, z)."""
+        p = np.asarray(point, dtype=float)[:3]
+        k = len(p)
+        a, b = self.ee[:-1, :k], self.ee[1:, :k]
         d = b - a
         length2 = np.einsum("ij,ij->i", d, d)
         u = np.clip(np.einsum("ij,ij->i", p - a, d) / np.maximum(length2, 1e-300), 0.0, 1.0)

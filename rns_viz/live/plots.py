@@ -6,8 +6,20 @@ import threading
 
 import numpy as np
 
-# "suppress" is 1.0 while the operated run had suppression on (the shadow had it off), else 0.0
-PLOT_SERIES = ("t", "xb", "xb_shadow", "L", "L_shadow", "ee_error", "suppress")
+# "suppress" is 1.0 while the operated run had suppression on (the shadow had it off), else 0.0.
+# xb is the base deflection (mm): x_b itself on a 1-DOF base, |translation| on a larger one, whose
+# coordinates are xb_1 ... xb_6 (mm or mrad, the operated run; 0 beyond the base's m).
+BASE_COORDINATES = 6
+PLOT_SERIES = (
+    "t",
+    "xb",
+    "xb_shadow",
+    "L",
+    "L_shadow",
+    "ee_error",
+    "suppress",
+    *(f"xb_{i + 1}" for i in range(BASE_COORDINATES)),
+)
 
 
 class PlotBuffers:

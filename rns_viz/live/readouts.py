@@ -49,7 +49,7 @@ def coupling_sigma(model: FsmsModel, theta: np.ndarray) -> float:
 @cache
 def _warning_levels(name: str) -> tuple[float, float]:
     """10 % of both distances at the model's default configuration: below that the GUI warns."""
-    model = FsmsModel.from_name(name)
+    model = FsmsModel.from_key(name)
     _, s_h, s_j, _ = _sigmas(model, model.spec.default_configuration)
     return 0.1 * s_h, 0.1 * s_j
 
@@ -67,6 +67,7 @@ def compute_readouts(
         warn_jbar=warn_j,
         n=tuple(float(v) for v in null_vector(H)) if rns_dim == 1 else None,
         rns_dim=rns_dim,
+        base_dof=model.m,
         L=L,
         ee_error=ee_error,
         reaction=reaction,

@@ -58,6 +58,7 @@ class Readouts:
     warn_jbar: float = math.nan  # m/rad
     n: tuple[float, ...] | None = None  # kg m: null-space vector of a 1-D RNS (Eq. 27)
     rns_dim: int = 0
+    base_dof: int = 1  # m: the base's coordinates
     L: float = 0.0  # kg m/s: coupling momentum S H_bm theta' (first selected row)
     ee_error: float = math.nan  # m: |x_ref - x_e|
     reaction: float = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1)

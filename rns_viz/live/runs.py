@@ -49,11 +49,12 @@ class RunPair:
         self._live: tuple[LiveLaw, LiveLaw] | None = None  # None: a preset's own laws run
 
     @classmethod
-    def at_rest(cls, name: str, theta0: np.ndarray) -> RunPair:
-        """Two runs of model ``name`` at rest at ``theta0``, t = 0, with placeholder laws (see :meth:`install`)."""
+    def at_rest(cls, name: str | FsmsModel, theta0: np.ndarray) -> RunPair:
+        """Two runs of model ``name`` (a model key, or a checked model to copy) at rest at ``theta0``, t = 0,
+        with placeholder laws (see :meth:`install`)."""
         sims = []
         for log_capacity in (LOG_CAPACITY, SHADOW_LOG_CAPACITY):
-            model = FsmsModel.from_name(name)
+            model = FsmsModel.from_key(name) if isinstance(name, str) else FsmsModel(name.spec)
             law = build_law(model, "acceleration", Gains(), False, JointSample.held(theta0)).law
             sims.append(Simulator(model, law, DT, q0=model.q(theta0), log_capacity=log_capacity))
         return cls(*sims)

@@ -32,7 +32,7 @@ from rns_viz.live.plots import PlotBuffers
 from rns_viz.live.recorder import Recording
 from rns_viz.live.records import Notice, Overlays, Snapshot
 from rns_viz.live.state import LiveState
-from rns_viz.params import MODEL_NAMES
+from rns_viz.params import check_model_key
 from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S
 
 PUBLISH_EVERY = 4  # steps between snapshots (250 Hz; the GUI renders at 60 Hz)
@@ -41,8 +41,7 @@ BURST_S = 0.003  # wall s: when ahead, the loop sleeps until this much simulatio
 
 class Session:
     def __init__(self, model: str = "trep", realtime: bool = True, shadow: bool = True, speed: float = 1.0) -> None:
-        if model not in MODEL_NAMES:
-            raise ValueError(f"unknown model {model!r}; choose one of {', '.join(MODEL_NAMES)}")
+        check_model_key(model)  # a bad model file raises ModelFileError (a ValueError) when the state loads it
         if speed not in SPEEDS:
             raise ValueError(f"speed must be one of {SPEEDS}")
         self.realtime = realtime
@@ -142,9 +141,10 @@ class Session:
     def set_speed(self, speed: float, client: int | None = None) -> None:
         self.send(c.SetSpeed(speed, client=client))
 
-    def kick(self, peak: float, client: int | None = None) -> None:
-        """A half-sine push on the base (N), of the model's default duration."""
-        self.send(c.Kick(peak, client=client))
+    def kick(self, peak: float, client: int | None = None, direction: tuple[float, ...] | None = None) -> None:
+        """A half-sine push on the base (N), of the model's default duration, weighted over the base
+        coordinates by ``direction`` (None: the first coordinate alone)."""
+        self.send(c.Kick(peak, direction, client=client))
 
     def set_suppression(self, on: bool, client: int | None = None) -> None:
         self.send(c.SetSuppression(on, client=client))
@@ -165,8 +165,9 @@ class Session:
     def set_shadow(self, on: bool, client: int | None = None) -> None:
         self.send(c.SetShadow(on, client=client))
 
-    def set_target(self, xy: tuple[float, float] | np.ndarray, final: bool = False, client: int | None = None) -> None:
-        """Drag the end-effector target to (x, y) in the base frame, m; ``final`` at the end of a drag."""
+    def set_target(self, xy: tuple[float, ...] | np.ndarray, final: bool = False, client: int | None = None) -> None:
+        """Drag the end-effector target to (x, y) (planar) or (x, y, z) in the base frame, m; ``final`` at the
+        end of a drag."""
         self.send(c.DragTarget(xy, final, client=client))  # type: ignore[arg-type]
 
     def scrub(self, sigma: float, client: int | None = None) -> None:
@@ -190,7 +191,12 @@ class Session:
         self.send(c.PointToPoint(client=client))
 
     def switch_model(self, name: str, client: int | None = None) -> None:
+        """Another model: a bundled name or a parameter file (refused with the element at fault if bad)."""
         self.send(c.SwitchModel(name, client=client))
+
+    def set_selection(self, flags: tuple[bool, ...], client: int | None = None) -> None:
+        """Selection S (Sec. III-B): which base reactions must vanish; the runs restart at rest where the arm is."""
+        self.send(c.SetSelection(tuple(flags), client=client))
 
     def load_preset(self, name: str, client: int | None = None, paused: bool = False) -> None:
         """Build preset ``name`` off the loop and adopt it at t = 0 (``paused``: waiting for Resume)."""

@@ -17,21 +17,20 @@ from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetRe
 from rns_viz.live.dual import refuse_other_laws
 from rns_viz.live.gain_explorer import GainExplorer
 from rns_viz.live.geometry import Geometry
-from rns_viz.live.guard import GUARD_EVERY, Bounds
+from rns_viz.live.guard import GUARD_EVERY
 from rns_viz.live.kicks import kick_pulse
 from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun, run_view
+from rns_viz.live.loop_model import LoopModel, key_of, selection_key
 from rns_viz.live.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
 from rns_viz.live.path_table import PathTable
-from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Level, Notice, ReplayView, Settings, Snapshot
 from rns_viz.live.replay import apply_replay
 from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.settle import settled_elsewhere
 from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
@@ -60,12 +59,11 @@ class LiveState:
 
     # ================================================================ set-up
     def _use_model(self, name: str) -> None:
+        """Make model ``name`` (a model key) the loop's model; a bad model file raises before any change."""
         if self.aux is None or self.aux.name != name:
-            self.aux = FsmsModel.from_name(name)  # the loop's own model for references and readouts
-            self.field = CouplingField(self.aux)
-            self.bounds = Bounds(self.aux)
-            self.reach_m = arm_reach(self.aux)
-            self.tol = 1e-4 * self.aux.arm_mass * self.reach_m  # kg m: same level of the coupling potential
+            loaded = LoopModel.load(name)
+            self.aux, self.field, self.bounds = loaded.model, loaded.field, loaded.bounds
+            self.reach_m, self.tol = loaded.reach_m, loaded.tol
 
     @property
     def model(self) -> FsmsModel:
@@ -73,19 +71,19 @@ class LiveState:
         return self.aux
 
     def _choice(self) -> LawChoice:
-        st = self.settings
-        return LawChoice(st.law, st.gains, st.suppress)
+        return LawChoice(self.settings.law, self.settings.gains, self.settings.suppress)
 
-    def start_live(self, name: str) -> None:
-        """A fresh live run of model ``name`` at its default configuration, at rest, t = 0."""
+    def start_live(self, name: str, theta: np.ndarray | None = None) -> None:
+        """A fresh live run of model ``name`` (a model key) at rest at ``theta`` (default: the model's
+        default configuration), t = 0. A bad model file raises before anything changes."""
         self._use_model(name)
-        theta0 = self.model.spec.default_configuration
-        self.runs = RunPair.at_rest(name, theta0)
+        theta0 = self.model.spec.default_configuration if theta is None else np.array(theta, dtype=float)
+        self.runs = RunPair.at_rest(self.model, theta0)
         self._new_operator(theta0)
         self.settings = replace(self.settings, preset=None)
         self._restart_bookkeeping()
         op = self.operator
-        table = self.geometry.default_tables.get(name)
+        table = self.geometry.default_tables.get(name) if theta is None else None
         if table is not None and op is not None and op.accept_table(table, self.tol):
             self._took_table(table, default=True)
         else:
@@ -106,8 +104,7 @@ class LiveState:
         self.epoch += 1
         self.settings_version += 1
         self.target_version += 1
-        self.paused = False
-        self.diverged = None
+        self.paused, self.diverged = False, None
         self.pacer.reanchor(self.runs.t)
         self.geometry.restart()
         self._waiting_for_path: c.Command | None = None
@@ -131,7 +128,7 @@ class LiveState:
         self._request_geometry(theta)
 
     def _adopt_preset(self, name: str, runs: RunPair) -> None:
-        self._use_model(LIVE_SCENARIOS[name].model)
+        self._use_model(key_of(runs.model))  # the preset's model with its own S (boom7-track: forces only)
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
@@ -153,8 +150,7 @@ class LiveState:
         self._explore(theta)
 
     def _explore(self, theta: np.ndarray) -> None:
-        st = self.settings
-        self.explorer.context(self.model.name, st.law, theta, st.gains)
+        self.explorer.context(self.model.name, self.settings.law, theta, self.settings.gains)
 
     def _took_table(self, table: PathTable, default: bool) -> None:
         self.geometry.took_table(self.model.name, table, default)
@@ -164,8 +160,7 @@ class LiveState:
         self.notices.append(Notice(title, body, client, level))
 
     def fail(self, why: str) -> None:
-        self.paused = True
-        self.diverged = why
+        self.paused, self.diverged = True, why
         self.notify("Simulation stopped", f"{why}. Press Reset to start again.", None, "error")
 
     # ================================================================ commands
@@ -206,9 +201,9 @@ class LiveState:
             case c.SetSpeed(speed=speed):
                 self.pacer.set_speed(speed, self.runs.t)
                 self.settings = replace(st, speed=speed)
-            case c.Kick(peak=peak):
+            case c.Kick(peak=peak, direction=direction):
                 duration = defaults_for(st.model).kick_duration_s
-                self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m))
+                self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m, direction))
                 self.kicks_sent += 1
                 self.explorer.kicked(self.runs.t)
             case c.SetSuppression(on=on):
@@ -256,8 +251,14 @@ class LiveState:
                 self._go_live().point_to_point(self.runs.t)
                 self.target_version += 1
             case c.SwitchModel(model=name):
+                self._use_model(name)  # a bad file stops here, the running model untouched
                 self.settings = Settings.defaults(name, st.shadow, st.speed)
                 self.start_live(name)
+            case c.SetSelection(flags=flags):  # the same system with another S, at rest where the arm is
+                key, note = selection_key(self.model, flags, self.runs.theta)
+                self.settings = replace(st, model=key, preset=None)
+                self.start_live(key, self.runs.theta.copy())
+                self.notify("Selection S", note, cmd.client, "warning" if not all(flags) else "info")
             case c.StartLesson(model=model, number=number):
                 lesson = LessonRun(model, number)
                 start = lesson.lesson.start
@@ -286,8 +287,7 @@ class LiveState:
     # ================================================================ steps
     def tick(self) -> bool:
         """One simulation step; False if the simulation stopped (diverged or left physical bounds)."""
-        runs, op = self.runs, self.operator
-        t = runs.t
+        runs, op, t = self.runs, self.operator, self.runs.t
         if op is not None:
             change = op.advance(t, runs.sim.dt)
             if change.joint_move_changed:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import gc
 import threading
 import time
+from collections.abc import Sequence
 from typing import Any
 
 import viser
@@ -22,11 +23,13 @@ import viser
 from rns_viz.live.operator_lock import OperatorLock
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
+from rns_viz.viz.base_panel import BasePanel
 from rns_viz.viz.client_pace import ClientPace
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gui import GuiElements, make_gui
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.lesson_panel import LessonPanel
+from rns_viz.viz.model_menu import ModelMenu
 from rns_viz.viz.path_words import PathWords
 from rns_viz.viz.pictures import Pictures
 from rns_viz.viz.render import TARGET_HANDLE, Renderer
@@ -41,17 +44,28 @@ class RnsApp:
     """The GUI and scene of one session on one viser server."""
 
     def __init__(
-        self, server: viser.ViserServer, session: Session, password: str | None = None, pace: bool = True
+        self,
+        server: viser.ViserServer,
+        session: Session,
+        password: str | None = None,
+        models: Sequence[str] = (),
+        pace: bool = True,
     ) -> None:
+        """``models``: parameter files offered in the model dropdown besides the bundled models;
+        ``pace=False``: every page gets every update however slowly it draws."""
         self.server = server
         self.session = session
         self.password = password
         self.connections = Connections(server, password)
-        self.gui: GuiElements = make_gui(server, session.snapshot().settings.model)
+        model = session.snapshot().settings.model
+        self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
+        self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
         self.view = make_view_toggles(server, self.connections)
         self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
-        self.renderer = Renderer(server, session, self.gui, self.controls, self.connections, self.view)
+        self.renderer = Renderer(
+            server, session, self.gui, self.controls, self.connections, self.view, base_panel=self.base_panel
+        )
         self.path_words = PathWords(server, self.gui.path_folder, order=self.gui.sigma.order + 0.01)
         self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
         self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
@@ -138,16 +152,19 @@ def start_app(
     realtime: bool = True,
     verbose: bool = True,
     lesson: int | None = None,
+    models: Sequence[str] = (),
     pace: bool = True,
 ) -> RnsApp:
     """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
-    ``lesson``: start at that lesson (1-based) of the model; ``pace=False``: every page gets every
-    update however slowly it draws (for comparisons; see :mod:`rns_viz.viz.client_pace`)."""
+    ``lesson``: start at that lesson (1-based) of the model; ``model`` is a bundled name or a parameter
+    file (ModelFileError names the element at fault), ``models`` more files for the model dropdown;
+    ``pace=False``: every page gets every update however slowly it draws (for comparisons; see
+    :mod:`rns_viz.viz.client_pace`)."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password, pace=pace).start()
+        app = RnsApp(server, session, password, models, pace=pace).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:
@@ -168,9 +185,10 @@ def serve(
     port: int = 8080,
     password: str | None = None,
     lesson: int | None = None,
+    models: Sequence[str] = (),
 ) -> None:
     """Serve the live app until interrupted (Ctrl+C). Binds 127.0.0.1 unless told otherwise."""
-    app = start_app(model, host, port, password, lesson=lesson)
+    app = start_app(model, host, port, password, lesson=lesson, models=models)
     print(f"rns_viz live app: http://{host}:{app.port}  (Ctrl+C to stop)")
     try:
         while True:

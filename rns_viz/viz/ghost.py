@@ -13,8 +13,9 @@ import viser
 
 from rns_viz.model import FsmsModel
 from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.boom_drawing import BoomDrawing
 from rns_viz.viz.robot import RobotMeshes
-from rns_viz.viz.style import CartSpringStyle, DoubleBeamStyle, SceneStyle
+from rns_viz.viz.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle
 
 GHOST_COLOUR = (90, 140, 235)  # pale blue, RGB 0-255
 GHOST_OPACITY = 0.35
@@ -72,7 +73,9 @@ class Ghost:
         q_draw[: self.model.m] *= exaggeration
         with self.server.atomic():
             self.robot.pose(q_draw)
-            if self.base_drawing is not None:
+            if isinstance(self.base_drawing, BoomDrawing):
+                self.base_drawing.pose(self.robot.base_placement())
+            elif self.base_drawing is not None:
                 self.base_drawing.update(self.robot.base_placement().translation)
 
     def drawn_base_position(self) -> np.ndarray:
@@ -81,9 +84,15 @@ class Ghost:
 
 
 def _ghost_base(
-    server: viser.ViserServer, model: FsmsModel, style: DoubleBeamStyle | CartSpringStyle | None
-) -> DoubleBeamDrawing | CartSpringDrawing | None:
+    server: viser.ViserServer, model: FsmsModel, style: DoubleBeamStyle | CartSpringStyle | BoomStyle | None
+) -> DoubleBeamDrawing | CartSpringDrawing | BoomDrawing | None:
     """The model's base drawing under /ghost, translucent, without its fixed parts (clamp, wall)."""
+    if isinstance(style, BoomStyle):
+        boom = BoomDrawing(server, model, style, root="/ghost/boom")
+        boom.mesh.color, boom.mesh.opacity = GHOST_COLOUR, GHOST_OPACITY
+        boom.stripe.colors = _tinted(boom.stripe.points)
+        _hide(server, "/ghost/boom/clamp")
+        return boom
     if isinstance(style, DoubleBeamStyle):
         beam = DoubleBeamDrawing(server, model, style, root="/ghost/beam")
         beam.mesh.color, beam.mesh.opacity = GHOST_COLOUR, GHOST_OPACITY

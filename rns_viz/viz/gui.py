@@ -19,15 +19,12 @@ from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
 from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS
 from rns_viz.viz.live_plots import LivePlots
+from rns_viz.viz.model_menu import ModelMenu
 
-MODEL_LABELS = {
-    "trep": "TREP (2R on a flexible beam)",
-    "planar3r": "planar 3R on a spring",
-    "trep2": "TREP + compensating arm",
-}
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
 PLANAR3R_PRESETS = ("fig3", "fig4")
+BOOM7_PRESETS = ("boom7-kick-on", "boom7-kick-off", "boom7-path", "boom7-track", "boom7-p2p")
 DUAL_PRESETS = tuple(DUAL_SCENARIOS)  # trep2: the task arm's circle and a kick, compensator on and off
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
@@ -101,16 +98,20 @@ class GuiElements:
     presets_trep: viser.GuiButtonGroupHandle
     presets_3r: viser.GuiButtonGroupHandle
     presets_dual: viser.GuiButtonGroupHandle
+    presets_boom7: viser.GuiButtonGroupHandle
     preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
+    menu: ModelMenu
     exaggeration: viser.GuiSliderHandle
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
 
 
-def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
-    """Build the panel for ``model`` (its kick range and exaggeration); the app wires the callbacks."""
+def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = None) -> GuiElements:
+    """Build the panel for ``model`` (its kick range and exaggeration; ``menu``: the models offered, by
+    default the bundled ones); the app wires the callbacks."""
+    menu = menu or ModelMenu((model,))
     gui = server.gui
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
     gui.main_panel.dock_right()
@@ -132,7 +133,8 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
             max=defaults_for(model).kick_range_N,
             step=0.1,
             initial_value=defaults_for(model).kick_peak_N,
-            hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R).",
+            hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R); on a "
+            "spatial base, along the direction chosen under Base coordinates (N m on a rotation).",
         )
         suppression = gui.add_checkbox(
             "Vibration suppression",
@@ -152,6 +154,7 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=preset_hint(TREP_PRESETS))
         presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=preset_hint(PLANAR3R_PRESETS))
         presets_dual = gui.add_button_group("TREP + compensator", DUAL_PRESETS, hint=preset_hint(DUAL_PRESETS))
+        presets_boom7 = gui.add_button_group("Boom (3-D)", BOOM7_PRESETS, hint=preset_hint(BOOM7_PRESETS))
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
@@ -236,10 +239,11 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
     with gui.add_folder("Model and view", expand_by_default=False):
         model_dd = gui.add_dropdown(
             "Model",
-            tuple(MODEL_LABELS.values()),
-            initial_value=MODEL_LABELS[model],
+            menu.labels,
+            initial_value=menu.label(model),
             hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring. "
-            "TREP + compensating arm: a second arm on the beam tip cancels the first one's reaction.",
+            "The 7-DOF arm on a flexible boom: a spatial system, six base coordinates. Files: given with --model.",
+            DUAL_PRESETS=tuple(DUAL_SCENARIOS),  # trep2: the task arm's circle and a kick, compensator on and off
         )
         exaggeration = gui.add_slider(
             "Deflection drawn ×",
@@ -294,9 +298,11 @@ def make_gui(server: viser.ViserServer, model: str) -> GuiElements:
         presets_trep=presets_trep,
         presets_3r=presets_3r,
         presets_dual=presets_dual,
+        presets_boom7=presets_boom7,
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
+        menu=menu,
         exaggeration=exaggeration,
         shadow=shadow,
         download=download,

@@ -22,14 +22,13 @@ import viser
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.session import Session
 from rns_viz.viz.connections import Connections
-from rns_viz.viz.gui import MODEL_LABELS, SPEED_LABELS, GuiElements
+from rns_viz.viz.gui import SPEED_LABELS, GuiElements
 from rns_viz.viz.input_check import check_value
 from rns_viz.viz.live_plots import SCALES
 
 REFUSAL_REPEAT_S = 2.0  # s: a watcher dragging the handle is told at most this often
 
 _LAW_OF_LABEL = {v: k for k, v in LAW_LABELS.items()}
-_MODEL_OF_LABEL = {v: k for k, v in MODEL_LABELS.items()}
 _SPEED_OF_LABEL = {v: k for k, v in SPEED_LABELS.items()}
 _SCALE_OF_LABEL = {v: k for k, v in SCALES.items()}
 
@@ -50,6 +49,10 @@ class Controls:
         self._handle_home_requested = False
         self._drags: dict[int, np.ndarray] = {}  # client id -> last target of a drag in progress
         self._told: dict[int, float] = {}  # client id -> when a refused drag was last reported
+        # the kick's weights over the base coordinates (None: the first alone), set by the base panel
+        self.kick_direction: Callable[[], tuple[float, ...] | None] = lambda: None
+        self.spatial_target = False  # the handle gives (x, y, z), not (x, y): set by the renderer per model
+        self.target_lift = np.zeros(3)  # m: the handle is drawn this far above the target (base frame)
         self._wire()
 
     # ---------------------------------------------------------------- values shown vs. values in force
@@ -132,7 +135,9 @@ class Controls:
 
     def _wire(self) -> None:
         g, s = self.gui, self.session
-        self._on_input(g.kick, lambda _, c: s.kick(float(self.good(g.kick_peak)), c), button=True)
+        self._on_input(
+            g.kick, lambda _, c: s.kick(float(self.good(g.kick_peak)), c, self.kick_direction()), button=True
+        )
         self._on_input(g.kick_peak, lambda v, c: None)  # read at the next kick
         self._on_input(g.exaggeration, lambda v, c: None)  # read by the render thread
         self._on_input(g.suppression, lambda v, c: s.set_suppression(bool(v), c))
@@ -151,10 +156,10 @@ class Controls:
         for name, slider in g.gains.items():
             self._on_input(slider, lambda v, c, name=name: s.set_gains(c, **{name: float(v)}))
         self._on_input(g.preset_paused, lambda v, c: None)  # read at the next preset
-        for group in (g.presets_trep, g.presets_3r, g.presets_dual):
+        for group in (g.presets_trep, g.presets_3r, g.presets_dual, g.presets_boom7):
             self._on_input(group, lambda v, c: s.load_preset(v, c, bool(self.good(g.preset_paused))), button=True)
         self._on_input(g.plots.scale, lambda v, c: g.plots.show_mode(_SCALE_OF_LABEL[v]))
-        self._on_input(g.model, lambda v, c: s.switch_model(_MODEL_OF_LABEL[v], c))
+        self._on_input(g.model, lambda v, c: s.switch_model(g.menu.key_of(v), c))
         self._on_input(g.shadow, lambda v, c: s.set_shadow(bool(v), c))
         g.download.on_click(self._on_download)
 
@@ -178,7 +183,7 @@ class Controls:
 
     # ---------------------------------------------------------------- the target handle
     def on_drag(self, event: viser.TransformControlsEvent) -> None:
-        """A drag of the target handle: its x, y become the session's target."""
+        """A drag of the target handle: its x, y (and z for a spatial model) become the session's target."""
         client = event.client
         cid = None if client is None else client.client_id
         if not self.connections.allowed(client):
@@ -191,9 +196,9 @@ class Controls:
         end = event.phase == "end"
         try:
             position = np.asarray(event.target.position, dtype=float)
-            xy = position[:2]
-            if xy.shape != (2,) or not np.all(np.isfinite(position)):
-                raise ValueError(f"the target must be two finite coordinates, got {position}")
+            xy = (position - self.target_lift)[:3] if self.spatial_target else position[:2]
+            if xy.shape != ((3,) if self.spatial_target else (2,)) or not np.all(np.isfinite(position)):
+                raise ValueError(f"the target must be finite coordinates, got {position}")
             self.session.set_target(xy, end, cid)
         except ValueError as exc:
             self._handle_home_requested = True

@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
+import html
 import math
 
+import numpy as np
+
 from rns_viz.live.records import Snapshot
+from rns_viz.params import key_selection
+from rns_viz.viz.model_menu import label_of
 from rns_viz.viz.units import si
 
 OK_COLOUR = "#1b7f3b"
 WARN_COLOUR = "#c77700"
 BAD_COLOUR = "#c0262d"
-SHORT_NAMES = {"trep": "TREP", "planar3r": "planar 3R", "trep2": "TREP + compensator"}
 
 
 def _badge(text: str, colour: str) -> str:
@@ -23,7 +27,7 @@ def _badge(text: str, colour: str) -> str:
 def status_html(snap: Snapshot) -> str:
     """One line: model, simulated time, real-time factor and state, with flags in colour."""
     st = snap.settings
-    model = SHORT_NAMES.get(st.model, st.model)
+    model = html.escape(label_of(st.model))
     if snap.diverged:
         state = _badge("STOPPED", BAD_COLOUR)
     elif snap.paused:
@@ -33,6 +37,9 @@ def status_html(snap: Snapshot) -> str:
     rtf = "–" if snap.paused or not math.isfinite(snap.rtf) else f"{snap.rtf:.2f}"
     behind = " " + _badge("FALLING BEHIND", BAD_COLOUR) if snap.behind else ""
     preset = f" · preset <b>{st.preset}</b>" if st.preset else ""
+    flags = key_selection(st.model)
+    if flags is not None:
+        preset += f" · S = {''.join(map(str, flags))}"
     speed = f"{st.speed:g}×"
     return (
         f'<div style="font-size:0.9em;line-height:1.5">{state}{behind} <b>{model}</b>{preset}<br>'
@@ -48,6 +55,16 @@ def _value(v: float, warn: float, unit: str, digits: int = 3) -> str:
     if math.isfinite(warn) and v < 0.2 * warn:
         colour = BAD_COLOUR
     return f'<span style="color:{colour};font-weight:600">{v:.{digits}g} {unit}</span>'
+
+
+def _deflection(snap: Snapshot) -> str:
+    """x_b of a 1-DOF base; the tip's translation |(x, y, z)| and rotation |(rx, ry, rz)| of a 6-DOF one."""
+    q = snap.q
+    if snap.readouts.base_dof <= 1:
+        return si(float(q[0]), "m", 1e-9, True)
+    m = snap.readouts.base_dof
+    text = si(float(np.linalg.norm(q[: min(m, 3)])), "m", 1e-9)
+    return text + (f", {si(float(np.linalg.norm(q[3:m])), 'rad', 1e-9)}" if m > 3 else "")
 
 
 def readouts_html(snap: Snapshot) -> str:
@@ -76,7 +93,7 @@ def readouts_html(snap: Snapshot) -> str:
             si(r.L, "N·s", 1e-9, True),
             "momentum the joints hand to the base (purple arrow), Eq. (8); 1 N·s = 1 kg·m/s",
         ),
-        ("x<sub>b</sub>", si(float(snap.q[0]), "m", 1e-9, True), "how far the base is bent from rest"),
+        ("x<sub>b</sub>", _deflection(snap), "how far the base is bent from rest"),
         ("end-effector error", err, "how far the hand is from where the law sends it"),
         (
             "reaction on base",

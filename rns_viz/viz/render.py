@@ -23,14 +23,10 @@ from rns_viz.live.records import Snapshot
 from rns_viz.live.replay import replay_snapshot
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
+from rns_viz.viz.base_panel import BasePanel
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gain_panel import GainExplorerView
-from rns_viz.viz.gui import (
-    MODEL_LABELS,
-    SPEED_LABELS,
-    GuiElements,
-    preset_description,
-)
+from rns_viz.viz.gui import SPEED_LABELS, GuiElements, preset_description
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
 from rns_viz.viz.panel_text import readouts_html, status_html
@@ -59,8 +55,10 @@ class Renderer:
         controls: Controls,
         connections: Connections,
         view: ViewToggles | None = None,
+        base_panel: BasePanel | None = None,
     ) -> None:
         self.server = server
+        self.base_panel = base_panel
         self.view = view or ViewToggles({})
         self.text_panels: list[Callable[[Snapshot], None]] = []  # more panels refreshed with the text (5 Hz)
         self.session = session
@@ -88,7 +86,8 @@ class Renderer:
 
     # ---------------------------------------------------------------- scene
     def _build_scene(self, snap: Snapshot) -> None:
-        self.model = FsmsModel.from_name(snap.settings.model)  # drawing only (its own pinocchio data)
+        self.model = FsmsModel.from_key(snap.settings.model)  # drawing only (its own pinocchio data)
+        spatial = len(self.model.task_rows) == 3  # the handle moves in 3-D and gives (x, y, z)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
         self._reach = arm_reach(self.model)
         self.teach = TeachScene(self.server, self.model, self.scene)
@@ -100,12 +99,16 @@ class Renderer:
         self.handle = self.server.scene.add_transform_controls(
             TARGET_HANDLE,
             scale=10.0 * st.marker_radius,
-            active_axes=(True, True, False),
+            active_axes=(True, True, spatial),
             disable_rotations=True,
             depth_test=False,
             position=self._home(snap) + np.array([0.0, 0.0, st.overlay_z]),
         )
         self.handle.on_update(self.controls.on_drag)
+        self.controls.spatial_target = spatial
+        self.controls.target_lift = np.array([0.0, 0.0, st.overlay_z])
+        if self.base_panel is not None:
+            self.base_panel.for_model(self.model)
         self.server.scene.add_label(
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
@@ -247,6 +250,8 @@ class Renderer:
         arrays = self.session.plot_arrays() if replay is None else replay.recording.plot_arrays(snap.t)
         if self.gui.plots.update(arrays):
             self.plot_updates += 1
+        if self.base_panel is not None and replay is None:
+            self.base_panel.update(arrays, version)
 
     def _update_text(self, snap: Snapshot) -> None:
         g = self.gui
@@ -311,7 +316,9 @@ class Renderer:
         show(g.target_speed, st.target_speed)
         show(g.shadow, st.shadow)
         show(g.speed, SPEED_LABELS[st.speed])
-        show(g.model, MODEL_LABELS[st.model])
+        show(g.model, g.menu.label(st.model))
+        if self.base_panel is not None:
+            self.base_panel.sync(snap, self.model)
         g.preset_info.content = preset_description(st.preset)
         on_path = self.model.n - len(self.model.selected) == 1
         g.path_folder.visible = on_path

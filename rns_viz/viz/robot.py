@@ -52,6 +52,7 @@ class RobotMeshes:
         self._world_posed = model.m  # joints 1..m are posed in the world, the rest relative to parents
         self._last: list[tuple[tuple[float, ...], tuple[float, ...]] | None] = [None] * len(self.frames)
         self.meshes: list[viser.SceneNodeHandle] = []
+        carrying = {model.m}  # joints whose node carries visuals: the base node (and its children) always
         scene = urdf.scene
         for geom_name, mesh in scene.geometry.items():
             link = scene.graph.transforms.parents[geom_name]
@@ -59,7 +60,11 @@ class RobotMeshes:
             local = mesh.copy()
             local.apply_transform(frame.placement.homogeneous @ urdf.get_transform(geom_name, link))
             node = self.node_names[frame.parentJoint]
+            carrying.add(frame.parentJoint)
             self.meshes.append(self._add_mesh(server, f"{node}/{link}_{geom_name}", local))
+        # Base joints before the last are world-posed nodes of their own; one without visuals (boom7's
+        # massless links between its six tip coordinates) shows nothing, so its pose is never sent.
+        self._posed = [j > model.m or j in carrying for j in range(1, pm.njoints)]
 
     def _add_mesh(self, server: viser.ViserServer, name: str, mesh: trimesh.Trimesh) -> viser.SceneNodeHandle:
         """One visual; a subclass may draw it otherwise (the ghost: one translucent colour)."""
@@ -70,6 +75,8 @@ class RobotMeshes:
         pm, data = self.model.pin_model, self.data
         pin.forwardKinematics(pm, data, q)
         for i, handle in enumerate(self.frames):
+            if not self._posed[i]:
+                continue
             j = i + 1
             M = data.oMi[j] if j <= self._world_posed else data.liMi[j]
             position = tuple(M.translation.tolist())

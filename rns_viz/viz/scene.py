@@ -18,9 +18,10 @@ import viser
 from rns_viz.model import FsmsModel
 from rns_viz.paths import ReactionlessPath
 from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.boom_drawing import BoomDrawing
 from rns_viz.viz.geometry import Trail, path_colours, path_family_segments, polyline_segments
 from rns_viz.viz.robot import RobotMeshes
-from rns_viz.viz.style import CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
+from rns_viz.viz.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
 
 PATH_COLOUR = (0.62, 0.74, 0.88)  # other reactionless paths, RGB in [0, 1]
 PATH_HIGHLIGHT = (0.90, 0.05, 0.30)  # the current path
@@ -145,7 +146,9 @@ class FsmsScene:
         self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
         with self.server.atomic():
             self.robot.pose(q_draw)
-            if self.base_drawing is not None:
+            if isinstance(self.base_drawing, BoomDrawing):
+                self.base_drawing.pose(self.robot.base_placement())
+            elif self.base_drawing is not None:
                 self.base_drawing.update(self.robot.base_placement().translation)
             if trail and self.trail.push(self._trail_point()):
                 self._draw_trail()
@@ -252,14 +255,18 @@ class FsmsScene:
         scene.add_label("/base/label", "base x_b", position=st.base_label, anchor="bottom-center")
         if isinstance(st.base, DoubleBeamStyle):
             scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
+        elif isinstance(st.base, BoomStyle):
+            scene.add_label("/boom/label", "clamp", position=(0.0, 0.0, 2.0 * st.base.radius), anchor="bottom-center")
         elif isinstance(st.base, CartSpringStyle):
             middle = 0.5 * (st.base.wall_x + st.base.attach[0])
             scene.add_label("/spring/label", "k_b", position=(middle, 0.0, 0.05))
 
 
 def _make_base_drawing(
-    server: viser.ViserServer, model: FsmsModel, style: DoubleBeamStyle | CartSpringStyle | None
-) -> DoubleBeamDrawing | CartSpringDrawing | None:
+    server: viser.ViserServer, model: FsmsModel, style: DoubleBeamStyle | CartSpringStyle | BoomStyle | None
+) -> DoubleBeamDrawing | CartSpringDrawing | BoomDrawing | None:
+    if isinstance(style, BoomStyle):
+        return BoomDrawing(server, model, style)
     if isinstance(style, DoubleBeamStyle):
         return DoubleBeamDrawing(server, model, style)
     if isinstance(style, CartSpringStyle):

@@ -13,6 +13,7 @@ import numpy as np
 
 from rns_viz.live.readouts import arm_reach
 from rns_viz.model import FsmsModel
+from rns_viz.params import model_source
 
 Vec3 = tuple[float, float, float]
 
@@ -40,10 +41,19 @@ class CartSpringStyle:
 
 
 @dataclass(frozen=True)
+class BoomStyle:
+    """A tube clamped at the world origin, its tip at the base joint frame (a 6-DOF elastic boom tip)."""
+
+    radius: float = 0.05  # m, boom7's 100 mm tube
+    stations: int = 25  # rings along the boom
+    sides: int = 12  # vertices per ring
+
+
+@dataclass(frozen=True)
 class SceneStyle:
     """Per-model drawing choices; every length in metres."""
 
-    base: DoubleBeamStyle | CartSpringStyle | None
+    base: DoubleBeamStyle | CartSpringStyle | BoomStyle | None
     camera_position: Vec3
     camera_look_at: Vec3
     grid_z: float  # m, height of the ground grid
@@ -103,9 +113,25 @@ def style_for(model: FsmsModel) -> SceneStyle:
             trail_jump=1.5,
             base_label=(-0.22, 0.1, 0.0),
         )
+    if model_source(model.name) == "boom7":
+        return SceneStyle(
+            base=BoomStyle(),
+            camera_position=(5.4, -1.7, 1.25),
+            camera_look_at=(3.95, 0.0, 0.35),
+            grid_z=-0.6,
+            grid_size=12.0,
+            grid_cell=0.25,
+            marker_radius=0.025,
+            line_thickness=0.006,
+            force_scale=0.05,
+            force_arrow_max=0.6,
+            force_origin=(0.0, 0.0, -0.2),
+            trail_jump=0.3,
+            base_label=(0.0, -0.25, -0.1),
+        )
     reach = arm_reach(model)
     return SceneStyle(
-        base=None,
+        base=BoomStyle(radius=0.03 * reach) if model.m == 6 and not model.base_is_translational else None,
         camera_position=(0.8 * reach, -1.6 * reach, 1.8 * reach),
         camera_look_at=(0.0, 0.0, 0.0),
         grid_z=-0.1 * reach,

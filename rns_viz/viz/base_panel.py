@@ -1,0 +1,122 @@
+"""The panel of a base with several coordinates (boom7: x, y, z, rx, ry, rz): the kick's direction,
+the selection S (which reactions must vanish, Sec. III-B) with the reaction null space's dimension
+n - r, and a live plot of every base coordinate. Hidden for a 1-DOF base.
+
+The checkboxes make one typed command (:class:`~rns_viz.live.commands.SetSelection`) the loop
+applies; what the loop refuses (an RNS the app does not operate) comes back as a notice and the
+boxes show the selection in force again.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import viser
+
+from rns_viz.live.plots import BASE_COORDINATES
+from rns_viz.live.records import Snapshot
+from rns_viz.model import FsmsModel
+from rns_viz.params import key_selection
+from rns_viz.viz.inputs import Controls
+
+COLOURS = ("#1f6fd1", "#e0503a", "#2a9d4b", "#8e44ad", "#c77700", "#555555")
+ALL = "all together"
+
+
+def coordinate_names(model: FsmsModel) -> list[str]:
+    """Short names of the base coordinates ("base_rx" -> "rx") with units."""
+    names = []
+    for i, joint in enumerate(model.spec.base.joints):
+        short = joint.removeprefix("base_")
+        turns = model.pin_model.joints[i + 1].shortname().startswith("JointModelR")
+        names.append(f"{short} ({'mrad' if turns else 'mm'})")
+    return names
+
+
+class BasePanel:
+    def __init__(self, server: viser.ViserServer, controls: Controls, order: float) -> None:
+        gui = server.gui
+        self.controls = controls
+        with gui.add_folder("Base coordinates (spatial)", order=order) as self.folder:
+            self.direction = gui.add_dropdown(
+                "Kick along",
+                ("x",),
+                hint="The kick pushes along this base coordinate (N; N m on a rotation), or along all of them "
+                "at once. Along the boom's axis (x) it is very stiff: a sideways kick (y, z) shows the suppression.",
+            )
+            gui.add_markdown("**Selection S**: tick the base reactions that must vanish (Eq. 8).")
+            self.boxes = [gui.add_checkbox(f"S{i + 1}", True) for i in range(BASE_COORDINATES)]
+            self.rns = gui.add_markdown("")
+            self.plot = gui.add_uplot(
+                data=tuple(np.zeros(2) for _ in range(BASE_COORDINATES + 1)),
+                series=(
+                    {"label": "t (s)"},
+                    *({"label": f"c{i + 1}", "stroke": COLOURS[i], "width": 1.5} for i in range(BASE_COORDINATES)),
+                ),
+                title="Base coordinates (operated run)",
+                scales={"x": {"time": False, "auto": True}, "y": {"auto": True}},
+                axes=({"size": 28}, {"label": "mm, mrad", "size": 64}),
+                legend={"show": True, "live": False},
+                cursor={"show": False},
+                aspect=2.1,
+            )
+        self.m = 1
+        self.plot_version = -1
+        controls.on_input(self.direction, lambda v, c: None)  # read at the next kick
+        for box in self.boxes:
+            controls.on_input(box, lambda v, c: controls.session.set_selection(self._flags(), c))
+        controls.kick_direction = self.kick_direction
+
+    def _flags(self) -> tuple[bool, ...]:
+        return tuple(bool(box.value) for box in self.boxes[: self.m])
+
+    def kick_direction(self) -> tuple[float, ...] | None:
+        """The kick's weights over the base coordinates (None for a 1-DOF base)."""
+        if self.m == 1:
+            return None
+        choice = self.controls.good(self.direction)
+        options = list(self.direction.options)
+        if choice == ALL:
+            return (1.0,) * self.m
+        index = options.index(choice) if choice in options else 1
+        return tuple(1.0 if i == index else 0.0 for i in range(self.m))
+
+    def for_model(self, model: FsmsModel, default_axis: int = 1) -> None:
+        """Show the panel for ``model`` (hidden for a 1-DOF base)."""
+        self.m = model.m
+        self.folder.visible = model.m > 1
+        if model.m == 1:
+            return
+        names = coordinate_names(model)
+        with self.controls.quiet():
+            self.direction.options = (*(n.split(" ")[0] for n in names), ALL)
+        self.controls.show(self.direction, self.direction.options[min(default_axis, model.m - 1)])
+        for i, box in enumerate(self.boxes):
+            box.visible = i < model.m
+            if i < model.m:
+                box.label = names[i].split(" ")[0]
+        self.plot_version = -1
+
+    def sync(self, snap: Snapshot, model: FsmsModel) -> None:
+        """Show the selection in force and the RNS dimension it leaves."""
+        if self.m == 1:
+            return
+        flags = key_selection(snap.settings.model) or tuple(int(f) for f in model.spec.base.selection)
+        for box, flag in zip(self.boxes, flags, strict=False):
+            self.controls.show(box, bool(flag))
+        r = sum(flags)
+        n = model.n
+        what = (
+            "a 1-D reaction null space: the arm moves without reaction only along its reactionless path "
+            "(scrub ū or drag the handle)"
+            if n - r == 1
+            else f"a {n - r}-D reaction null space: drag the handle in 3-D, the hand tracks it by Eq. (24)"
+        )
+        self.rns.content = f"r = {r} of {model.m}; n − r = {n} − {r} = **{n - r}**: {what}."
+
+    def update(self, arrays: dict[str, np.ndarray], version: int) -> None:
+        """Send the base coordinates of the operated run (plot buffers in mm / mrad)."""
+        if self.m == 1 or version == self.plot_version or len(arrays["t"]) < 2:
+            return
+        self.plot_version = version
+        columns = [np.nan_to_num(arrays[f"xb_{i + 1}"]) for i in range(BASE_COORDINATES)]
+        self.plot.data = (arrays["t"], *columns)

@@ -1,0 +1,118 @@
+"""Any model in the running app: the model dropdown lists the bundled models and the parameter files
+given to the app (``rns-viz serve --model FILE.toml``); switching among them keeps the server and
+every client served; a file that has gone bad is refused with a message naming the element at
+fault, and the app keeps the model it runs. A headless server driven by protocol-level clients.
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rns_viz.cli import main
+from rns_viz.params import ASSETS_DIR
+from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.base_panel import BasePanel
+from rns_viz.viz.model_menu import MODEL_LABELS
+from tests.browser import wait_for_clients, wait_until
+from tests.protocol_client import ProtocolClient, gui_uuid
+
+
+def user_model(folder: Path) -> Path:
+    """A user's own model: the planar 3R's URDF and parameters under another name, in another folder."""
+    shutil.copy(ASSETS_DIR / "planar3r.urdf", folder / "my_arm.urdf")
+    text = (ASSETS_DIR / "planar3r.toml").read_text()
+    text = text.replace('name = "planar3r"', 'name = "my_arm"').replace('"planar3r.urdf"', '"my_arm.urdf"')
+    path = folder / "my_arm.toml"
+    path.write_text(
+        text.replace(
+            "default_configuration_deg = [60.0, -60.0, -60.0]", "default_configuration_deg = [50.0, -60.0, -60.0]"
+        )
+    )
+    return path
+
+
+@pytest.fixture
+def app_with_file(tmp_path: Path) -> Iterator[tuple[RnsApp, Path, ProtocolClient, ProtocolClient, list]]:
+    path = user_model(tmp_path)
+    app = start_app("trep", port=0, realtime=False, verbose=False, models=(str(path),))
+    told: list[tuple[int | None, str, str]] = []
+    original = app.connections.notify_by_id
+
+    def record(client_id, title, body, level):  # type: ignore[no-untyped-def]
+        told.append((client_id, title, body))
+        original(client_id, title, body, level)
+
+    app.connections.notify_by_id = record  # type: ignore[method-assign]
+    operator = ProtocolClient(app.port)
+    wait_for_clients(app, 1, "the operator")
+    watcher = ProtocolClient(app.port)
+    wait_for_clients(app, 2, "a watcher")
+    yield app, path, operator, watcher, told
+    operator.close()
+    watcher.close()
+    app.stop()
+
+
+def choose(app: RnsApp, client: ProtocolClient, label: str) -> None:
+    """Pick ``label`` in the model dropdown from a client, and let the loop apply it."""
+    client.set_value(gui_uuid(app.gui.model), label)
+    wait_until(lambda: "SwitchModel" in app.session.pending_commands(), 10.0, "the model switch to be queued")
+    app.session.advance(0.05)
+
+
+def test_the_dropdown_switches_among_bundled_models_and_a_file_and_every_client_stays_served(app_with_file) -> None:  # type: ignore[no-untyped-def]
+    app, path, operator, watcher, _ = app_with_file
+    labels = app.gui.model.options
+    assert MODEL_LABELS["boom7"] in labels and "file: my_arm.toml" in labels
+    for label, key, m in (
+        (MODEL_LABELS["boom7"], "boom7", 6),
+        ("file: my_arm.toml", str(path.resolve()), 1),
+        (MODEL_LABELS["trep"], "trep", 1),
+        (MODEL_LABELS["boom7"], "boom7", 6),
+    ):
+        choose(app, operator, label)
+        snap = app.session.snapshot()
+        assert snap.settings.model == key and snap.q.shape == (app.session.state.model.nv,)
+        assert app.session.state.model.m == m
+        wait_until(lambda key=key: app.model_name == key, 20.0, f"the scene of {key}")
+        before = watcher.messages
+        app.session.advance(0.2)
+        wait_until(lambda before=before: watcher.messages > before, 10.0, "the watcher to get updates")
+        assert app.render_thread.is_alive() and not watcher.closed.is_set() and not operator.closed.is_set()
+        panel: BasePanel = app.base_panel
+        wait_until(lambda m=m, p=panel: p.folder.visible == (m > 1), 10.0, "the base panel (6-DOF bases only)")
+    theta = app.session.state.model.spec.default_configuration
+    assert np.all(np.isfinite(app.session.snapshot().q)) and len(theta) == 7
+
+
+def test_a_bad_model_file_is_refused_naming_the_element_and_the_app_keeps_its_model(app_with_file) -> None:  # type: ignore[no-untyped-def]
+    app, path, operator, watcher, told = app_with_file
+    app.session.kick(0.8)
+    app.session.advance(0.5)
+    q_before = app.session.snapshot().q.copy()
+    path.write_text(path.read_text().replace("stiffness = [[100.0]]", "stiffness = [[100.0, 1.0]]"))
+    choose(app, operator, "file: my_arm.toml")
+    wait_until(lambda: any("stiffness" in body for _, _, body in told), 10.0, "the refusal to reach the operator")
+    client, _, body = next(t for t in told if "stiffness" in t[2])
+    assert "my_arm.toml" in body and "[base] stiffness" in body and "shape" in body
+    assert client == app.lock.operator  # told to the client who asked
+    snap = app.session.snapshot()
+    assert snap.settings.model == "trep" and snap.t > 0.5 and np.allclose(snap.q[1:], q_before[1:], atol=0.1)
+    wait_until(lambda: app.gui.model.value == MODEL_LABELS["trep"], 10.0, "the dropdown to show TREP again")
+    before = watcher.messages
+    app.session.advance(0.2)  # the simulation runs on and the watcher is served
+    wait_until(lambda: watcher.messages > before, 10.0, "the watcher to get updates")
+    assert app.render_thread.is_alive() and app.model_name == "trep"
+
+
+def test_serve_refuses_a_bad_model_file_naming_the_element(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    path = user_model(tmp_path)
+    path.write_text(path.read_text().replace('joints = ["base_x"]', 'joints = ["base_q"]'))
+    assert main(["serve", "--model", str(path), "--port", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "[base] joints" in err and "base_q" in err and "my_arm.urdf" in err

@@ -1,0 +1,73 @@
+"""boom7 in a real headless Chromium: the 3-D model loads (boom tube, arm meshes, target handle, the
+base panel), a kick from the page is suppressed, the path slider moves the arm along its r = 6
+reactionless path; screenshots go to artifacts/app_boom7*.png.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
+from rns_viz.viz.scene import FsmsScene
+from tests.browser import (
+    browser_page,
+    dismiss_notifications,
+    requires_chromium,
+    screenshot,
+    wait_for_frames,
+    wait_for_nodes,
+    wait_until,
+)
+from tests.test_app_browser import click_track
+
+pytestmark = [pytest.mark.browser, requires_chromium]
+
+
+@pytest.fixture
+def boom_app() -> Iterator[RnsApp]:
+    app = start_app("boom7", port=0, verbose=False)
+    yield app
+    app.stop()
+
+
+def test_boom7_in_chromium_kick_and_scrub_the_reactionless_path(boom_app: RnsApp) -> None:
+    app, s = boom_app, boom_app.session
+    with browser_page(app.server, width=1400, height=900) as page:
+        wait_for_nodes(page, {FsmsScene.BASE, TARGET_HANDLE, "/boom/tube", "/boom/stripe"}, timeout=60.0)
+        dismiss_notifications(page)
+
+        # Kick sideways (the direction control's default, y) from the page: the shadow swings, the
+        # operated run is brought to rest by law (15) in all six modes.
+        assert app.base_panel.folder.visible and app.good(app.base_panel.direction) == "y"
+        page.get_by_role("button", name="Kick the base").click()
+        wait_until(lambda: abs(s.snapshot().q_shadow[1]) > 1e-4, 15.0, "the kick to bend the boom")  # type: ignore[index]
+        wait_until(lambda: np.abs(s.snapshot().q[:6]).max() < 1e-6, 20.0, "suppression to bring the boom to rest")
+
+        # The path slider (r = 6: a 1-D reaction null space) moves the arm along its reactionless path.
+        wait_until(lambda: app.gui.sigma.min < -10.0 and not app.gui.sigma.disabled, 60.0, "the path slider")
+        time.sleep(1.0)
+        for attempt in range(3):  # a software-rendered page may drop a click made while it re-lays the panel
+            click_track(page, app.gui.sigma.label, 0.15)
+            try:
+                wait_until(lambda: (s.snapshot().sigma or 0.0) < -20.0, 20.0, "the arm to move along the path")
+                break
+            except AssertionError:
+                if attempt == 2:
+                    raise
+        peak = float(np.abs(s.state.runs.sim.log.array(2000)[:, 2]).max())  # x_b column y over the motion, m
+        assert peak < 1e-5
+
+        wait_until(lambda: app.plot_updates > 5, 15.0, "live plot updates")
+        app.scene.set_initial_camera()
+        page.mouse.move(5, 5)
+        page.get_by_text("Operate", exact=True).scroll_into_view_if_needed()
+        dismiss_notifications(page)
+        wait_for_frames(page, 30)
+        assert screenshot(page, "app_boom7").stat().st_size > 10_000
+        page.get_by_text("Base coordinates (spatial)", exact=True).scroll_into_view_if_needed()
+        wait_for_frames(page, 10)
+        assert screenshot(page, "app_boom7_base_panel").stat().st_size > 10_000
