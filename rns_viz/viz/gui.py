@@ -242,8 +242,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             menu.labels,
             initial_value=menu.label(model),
             hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring. "
-            "The 7-DOF arm on a flexible boom: a spatial system, six base coordinates. Files: given with --model.",
-            DUAL_PRESETS=tuple(DUAL_SCENARIOS),  # trep2: the task arm's circle and a kick, compensator on and off
+            "TREP with a compensating arm: a second arm on the beam tip cancels the first one's reaction. The "
+            "7-DOF arm on a flexible boom: a spatial system, six base coordinates. Files: given with --model.",
         )
         exaggeration = gui.add_slider(
             "Deflection drawn ×",
