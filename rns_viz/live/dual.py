@@ -39,9 +39,9 @@ def is_dual(model: FsmsModel) -> bool:
 
 
 @cache
-def dual_by_name(name: str) -> bool:
-    """:func:`is_dual` of a bundled model, by name."""
-    return is_dual(FsmsModel.from_name(name))
+def dual_by_name(key: str) -> bool:
+    """:func:`is_dual` of the model a model key names (bundled or a file, with its S)."""
+    return is_dual(FsmsModel.from_key(key))
 
 
 def dual_law(model: FsmsModel, gains: Gains, suppress: bool, task: TaskSample | None, shadow: bool) -> CompensatingLaw:

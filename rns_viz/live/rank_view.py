@@ -51,10 +51,10 @@ def arm_pose(model: FsmsModel, theta: np.ndarray) -> np.ndarray:
 
 
 @cache
-def rank_overlay(name: str) -> RankOverlay | None:
-    """The overlay of a bundled single-arm model with 2 or 3 joints (None otherwise: a search over a
+def rank_overlay(key: str) -> RankOverlay | None:
+    """The overlay of a single-arm model (by model key) with 2 or 3 joints (None otherwise: a search over a
     larger joint grid is too slow to run on demand)."""
-    model = FsmsModel.from_name(name)
+    model = FsmsModel.from_key(key)
     if is_dual(model) or model.n not in SEEDS_PER_JOINT:
         return None
     loss = rank_deficient_configurations(model, points_per_joint=SEEDS_PER_JOINT[model.n])
