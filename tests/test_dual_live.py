@@ -111,6 +111,7 @@ def test_dual_presets_are_offered_and_the_shadow_flips_compensation() -> None:
     assert set(DUAL_SCENARIOS) <= set(LIVE_SCENARIOS)
     session = Session("trep", realtime=False)
     session.load_preset("trep2-circle-off")
+    session.advance(0.001)  # the loop applies the command: the preset is being built from now on
     assert session.wait_background(60.0)
     peaks = np.zeros(2)  # m: peak |x_b| of the operated run (held) and of the shadow (compensating)
     for _ in range(50):

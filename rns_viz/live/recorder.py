@@ -169,15 +169,17 @@ class Recording:
             if col in i:
                 own = d[rows, i[col]]
                 ref[:, a] = np.where(np.isfinite(own), own, ref[:, a])
-        shadow_xb = d[rows, i["shadow_xb_1"]] * 1e3
+        base = d[rows][:, self.columns_of("xb")] * 1e3  # mm (mrad for a rotation)
+        coordinates = {f"xb_{k + 1}": base[:, k] if k < base.shape[1] else 0.0 * base[:, 0] for k in range(6)}
         return {
             "t": d[rows, 0],
-            "xb": d[rows, i["xb_1"]] * 1e3,
-            "xb_shadow": shadow_xb,
-            "L": d[rows, i["L_1"]],
-            "L_shadow": d[rows, i["shadow_L_1"]],
+            "xb": _plotted(base),
+            "xb_shadow": _plotted(d[rows][:, self.columns_of("shadow_xb")] * 1e3),
+            "L": _plotted(d[rows][:, self.columns_of("L")]),
+            "L_shadow": _plotted(d[rows][:, self.columns_of("shadow_L")]),
             "ee_error": np.linalg.norm(ref - x, axis=1) * 1e3,
             "suppress": d[rows, i["suppress"]],
+            **coordinates,
         }
 
     def plot_arrays(self, t: float) -> dict[str, np.ndarray]:
@@ -282,3 +284,9 @@ class Recorder:
         k = min(self._count, max(2, round(seconds / self.dt)))
         rows = self._data[(self._next - k + np.arange(k)) % len(self._data)]  # a copy
         return Recording(self.columns, rows, model, self.dt)
+
+
+def _plotted(columns: np.ndarray) -> np.ndarray:
+    """What the live plots show of a block of coordinates (rows x k): the one column, or the length of the
+    first three (a base's translation, the linear momentum), as rns_viz.live.outputs plots it live."""
+    return columns[:, 0] if columns.shape[1] == 1 else np.sqrt(np.sum(columns[:, :3] ** 2, axis=1))
