@@ -1,0 +1,112 @@
+"""Benchmark: the Python closed-loop step of this tree against another checkout of rns_viz, same minute.
+
+Run on demand:  python benchmarks/bench_step_vs.py OTHER_TREE [--rounds 7] [--steps 3000]
+
+OTHER_TREE is the root of another checkout (e.g. a git worktree of an older commit). The step timed
+is ``Simulator.step()`` with ``native=False`` (law and RK4 in Python + pinocchio), law (15)
+``AccelerationLaw`` with ``Gains(g_b=10, g_m=1)`` and its default null input, RK4 at 1 ms, logging
+on, starting at the model's default configuration with v0 = (0.01, 0, ...), for TREP, the 3R and
+the generated 7-DOF arm of ``benchmarks/oracles.py`` (arm7).
+
+Each round runs one fresh subprocess per tree, the two alternating (and which goes first alternating
+too), so both see the same machine load; a subprocess warms up, then times ``--steps`` steps of each
+model as one block. Reported: min and median over the rounds of the per-step time, in µs, and the
+ratio this tree / other tree (below 1: this tree is faster).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+MODELS = ("trep", "planar3r", "arm7")
+
+
+def worker(steps: int, arm7_toml: str) -> None:
+    """Time ``steps`` Python steps per model with the rns_viz found on sys.path; print µs/step as JSON."""
+    import numpy as np
+
+    from rns_viz.control import AccelerationLaw, Gains
+    from rns_viz.model import FsmsModel
+    from rns_viz.sim import Simulator
+
+    result = {}
+    for name in MODELS:
+        model = FsmsModel.from_file(arm7_toml) if name == "arm7" else FsmsModel.from_name(name)
+        q0 = model.q(model.spec.default_configuration)
+        v0 = np.zeros(model.nv)
+        v0[0] = 0.01
+
+        def simulator(model: FsmsModel = model, q0: np.ndarray = q0, v0: np.ndarray = v0) -> Simulator:
+            law = AccelerationLaw(model, Gains(g_b=10.0, g_m=1.0))
+            return Simulator(model, law, q0=q0, v0=v0, log_capacity=steps + 1, native=False)
+
+        simulator().run(0.3)  # warm-up
+        sim = simulator()
+        step = sim.step
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            step()
+        result[name] = 1e6 * (time.perf_counter() - t0) / steps
+    print(json.dumps(result))
+
+
+def run_worker(tree: Path, steps: int, arm7_toml: Path) -> dict[str, float]:
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    command = [sys.executable, str(Path(__file__).resolve()), str(tree), "--worker", str(arm7_toml)]
+    done = subprocess.run([*command, "--steps", str(steps)], cwd=tree, env=env, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"worker in {tree} failed:\n{done.stderr}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("other", type=Path, help="root of the other checkout of rns_viz")
+    parser.add_argument("--rounds", type=int, default=7)
+    parser.add_argument("--steps", type=int, default=3000, help="timed steps per model and round")
+    parser.add_argument("--worker", metavar="ARM7_TOML", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.worker:
+        worker(args.steps, args.worker)
+        return
+
+    here = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(here))
+    from benchmarks.oracles import ARM7_TOML, arm7_urdf
+
+    trees = {"this": here, "other": args.other.resolve()}
+    times: dict[str, dict[str, list[float]]] = {tree: {name: [] for name in MODELS} for tree in trees}
+    load_before = os.getloadavg()
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "arm7.urdf").write_text(arm7_urdf())
+        (Path(tmp) / "arm7.toml").write_text(ARM7_TOML)
+        for r in range(args.rounds):
+            order = list(trees) if r % 2 == 0 else list(reversed(trees))
+            for tree in order:
+                for name, us in run_worker(trees[tree], args.steps, Path(tmp) / "arm7.toml").items():
+                    times[tree][name].append(us)
+
+    load = ", ".join(f"{x:.2f}" for x in (*load_before, *os.getloadavg()))
+    print(f"Python step (native=False), law (15) g_b=10 g_m=1, RK4 1 ms, {args.steps} steps x {args.rounds} rounds")
+    print(f"this: {trees['this']}\nother: {trees['other']}")
+    print(f"load average (1, 5, 15 min) before, after: {load}")
+    print(f"{'model':<10}{'this min':>10}{'median':>9}{'other min':>11}{'median':>9}{'ratio min':>11}{'median':>9}")
+    for name in MODELS:
+        a, b = times["this"][name], times["other"][name]
+        print(
+            f"{name:<10}{min(a):>10.1f}{statistics.median(a):>9.1f}{min(b):>11.1f}{statistics.median(b):>9.1f}"
+            f"{min(a) / min(b):>11.3f}{statistics.median(a) / statistics.median(b):>9.3f}"
+        )
+    print("µs per step; ratio = this / other (below 1: this tree is faster)")
+
+
+if __name__ == "__main__":
+    main()
