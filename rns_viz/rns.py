@@ -95,8 +95,16 @@ def _any_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInve
 
 
 def _one_row(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
-    """One row a: the column a / (|a|^2 + lambda^2), sigma = |a|. Python floats, no SVD."""
+    """One row a: :func:`damped_row_pinv`."""
     (a,) = A.tolist()
+    return damped_row_pinv(a, threshold, max_damping)
+
+
+def damped_row_pinv(
+    a: list[float], threshold: float = DEFAULT_THRESHOLD, max_damping: float = DEFAULT_MAX_DAMPING
+) -> DampedInverse:
+    """:func:`damped_pinv` of the one-row matrix [a] given as Python floats (a 1-DOF base, per step):
+    the column a / (|a|^2 + lambda^2), sigma = |a|. No SVD, no numpy call."""
     sigma2 = sum(map(operator.mul, a, a))
     sigma = math.sqrt(sigma2)
     lam2 = _damping_squared(sigma, threshold, max_damping)

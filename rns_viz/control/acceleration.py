@@ -26,7 +26,7 @@ def composite_acceleration(cp: Coupling, g_b: float, g_m: float, null: NullOutpu
     -G_m L is the law's -G_m (E - P) theta', because (E - P) theta' = H_bm^+ H_bm theta' = H_bm^+ L
     (Eqs. 8, 9), also with the damped inverse.
     """
-    if cp.H_bm.shape[0] == 1:
+    if cp.row is not None:
         return _one_coupling_row(cp, g_b, g_m, null)
     return _any_coupling_rows(cp, g_b, g_m, null)
 
@@ -38,16 +38,17 @@ def _any_coupling_rows(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -
 
 
 def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
-    """Eq. (15) for one coupling row h (a 1-DOF base), in Python floats (cheaper than numpy calls here).
+    """Eq. (15) for one coupling row h (a 1-DOF base), in the Python floats of ``cp.row`` (cheaper than
+    numpy calls here).
 
     The damped h^+ is h^T s, s = 1 / (|h|^2 + lambda^2), and the input's P (u - g_u theta')
     = u - g_u theta' - h^+ (h u - g_u L) joins the factor of h^+:
         theta'' = h^T s (g_b H_b x_b' - h' theta' - (g_m - g_u) L - h u) + u - g_u theta'.
     """
-    H_b, xdot_b, hbm_dot_thetadot, L = cp.row_terms()
+    row = cp.row
     g_u = null.damping
-    y = g_b * H_b * xdot_b - hbm_dot_thetadot - (g_m - g_u) * L
-    (h,), thetadot = cp.H_bm.tolist(), cp.thetadot.tolist()
+    y = g_b * row.H_b * row.xdot_b - row.hbm_dot_thetadot - (g_m - g_u) * row.L
+    h, thetadot = row.h, row.thetadot
     if null.u is None:
         alpha = y * cp.inverse.row_scale
         thetaddot = np.array([alpha * h_i - g_u * w for h_i, w in zip(h, thetadot, strict=True)])

@@ -7,8 +7,9 @@ v = (x_b', theta'); the law returns joint torques (N m) for the plant.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING, Literal, Protocol
+from typing import TYPE_CHECKING, Literal, NamedTuple, Protocol
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from rns_viz.model import FsmsModel
 
 if TYPE_CHECKING:
     from rns_viz.control.reference import ReferenceSample
-from rns_viz.rns import DampedInverse, damped_pinv, project_onto_rns, rns_projector
+from rns_viz.rns import DampedInverse, damped_pinv, damped_row_pinv, project_onto_rns, rns_projector
 
 LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
@@ -89,6 +90,19 @@ class ControlLaw(Protocol):
         ...
 
 
+class CouplingRow(NamedTuple):
+    """A one-row coupling (r = 1, e.g. a 1-DOF base) in Python floats, read by the one-row branches of
+    Eq. (15) and Fig. 1: for a few joints, numbers cost less than numpy calls on tiny arrays."""
+
+    H_b: float  # selected diagonal entry of the base inertia
+    xdot_b: float  # selected base velocity, m/s
+    hbm_dot_thetadot: float  # S H_bm' theta'
+    L: float  # S H_bm theta', Eq. (8)
+    h: list[float]  # (n,) S H_bm
+    thetadot: list[float]  # (n,) rad/s
+    M_rows: list[list[float]]  # the inertia matrix of Eq. (1), row by row
+
+
 class Coupling:
     """The blocks of Eq. (1) at one state, restricted to the selected base rows S.
 
@@ -110,6 +124,7 @@ class Coupling:
         "c",
         "coupling_momentum",
         "inverse",
+        "row",
         "sigma",
         "thetadot",
     )
@@ -132,6 +147,7 @@ class Coupling:
         self.H_bm = H_bm  # (r, n) S H_bm
         self.thetadot = v[m:]
         self.coupling_momentum = H_bm.dot(self.thetadot)  # (r,) L = S H_bm theta', Eq. (8)
+        self.row: CouplingRow | None = None  # the same coupling in Python floats (r = 1, CouplingEvaluator)
         self.inverse = inverse  # the damped H_bm^+ (rns.damped_pinv)
         self.sigma = inverse.sigma_min  # smallest singular value of S H_bm
         self._m, self._rows, self._H_b_index = m, rows, H_b_index
@@ -184,11 +200,6 @@ class Coupling:
         """P_RNS u without forming P_RNS (:func:`rns_viz.rns.project_onto_rns`)."""
         return project_onto_rns(u, self.H_bm, self.H_bm_pinv)
 
-    def row_terms(self) -> tuple[float, float, float, float]:
-        """H_b, x_b', H_bm' theta' and L of the single selected row (r = 1), as numbers."""
-        i = self._rows.start if type(self._rows) is slice else int(self._rows[0])
-        return self.M.item(i, i), self._v.item(i), self._hbm_dot.item(i), self.coupling_momentum.item(0)
-
 
 class CouplingEvaluator:
     """Evaluates :class:`Coupling` with the model's own pinocchio data (one per law)."""
@@ -209,12 +220,35 @@ class CouplingEvaluator:
         scale = float(np.linalg.svd(model.coupling_matrix(q0), compute_uv=False)[-1])
         self.threshold = singular_threshold if singular_threshold is not None else 0.1 * max(scale, 1e-9)
         self.max_damping = self.threshold
+        self._row = int(self.rows[0]) if len(self.rows) == 1 else None  # the one selected row
 
     def __call__(self, q: np.ndarray, v: np.ndarray) -> Coupling:
         M, c, hbm_dot = self.model.dynamics(q, v)
+        if self._row is not None:
+            return self._one_row(M, c, hbm_dot, q, v, self._row)
         H_bm = M[self._rows, self.model.m :]
         inverse = damped_pinv(H_bm, self.threshold, self.max_damping)
         return Coupling(M, c, hbm_dot, H_bm, inverse, q, v, self._rows, self._H_b_index)
+
+    def _one_row(
+        self, M: np.ndarray, c: np.ndarray, hbm_dot: np.ndarray, q: np.ndarray, v: np.ndarray, i: int
+    ) -> Coupling:
+        """The coupling of one selected base row i, its numbers taken once as Python floats (:class:`CouplingRow`).
+
+        Per step on a 1-DOF base: the slots of :class:`Coupling` are filled directly (what its
+        ``__init__`` computes with numpy on the one-row matrix comes here from the floats)."""
+        m = self.model.m
+        M_rows, v_values = M.tolist(), v.tolist()
+        h, thetadot = M_rows[i][m:], v_values[m:]
+        L = sum(map(operator.mul, h, thetadot))
+        inverse = damped_row_pinv(h, self.threshold, self.max_damping)
+        cp = Coupling.__new__(Coupling)
+        cp.M, cp.c, cp.H_bm, cp.thetadot = M, c, M[i : i + 1, m:], v[m:]
+        cp.coupling_momentum, cp.inverse, cp.sigma = np.array((L,)), inverse, inverse.sigma_min
+        cp.row = CouplingRow(M_rows[i][i], v_values[i], hbm_dot.item(i), L, h, thetadot, M_rows)
+        cp._m, cp._rows, cp._H_b_index = m, self._rows, self._H_b_index
+        cp._q, cp._v, cp._hbm_dot, cp._P = q, v, hbm_dot, None
+        return cp
 
 
 def realize_acceleration(
@@ -246,14 +280,15 @@ def _any_base_torques(
 def _one_dof_base_torques(
     model: FsmsModel, cp: Coupling, q: np.ndarray, v: np.ndarray, thetaddot: np.ndarray
 ) -> np.ndarray:
-    """:func:`realize_acceleration` for a 1-DOF base: x_b'' as a number, then the arm rows of Eq. (1)
-    as one product M_arm (x_b'', theta'') (fewer numpy calls than blocks, whatever n)."""
+    """:func:`realize_acceleration` for a 1-DOF base: x_b'' as a number from the floats of ``cp.row``,
+    then the arm rows of Eq. (1) as one product M_arm (x_b'', theta'') (fewer numpy calls than blocks)."""
     M, c = cp.M, cp.c
+    H_b, *h = cp.row.M_rows[0] if cp.row is not None else M[0].tolist()
     spring = -model.K_b.item(0) * q.item(0) - model.D_b.item(0) * v.item(0)
-    acceleration = np.empty(len(q))
-    acceleration[0] = (spring - c.item(0) - M[0, 1:].dot(thetaddot)) / M.item(0, 0)
-    acceleration[1:] = thetaddot
-    tau = M[1:] @ acceleration + c[1:]
+    accelerations = thetaddot.tolist()
+    xddot_b = (spring - c.item(0) - sum(map(operator.mul, h, accelerations))) / H_b
+    tau = M[1:].dot(np.array((xddot_b, *accelerations)))
+    tau += c[1:]
     if model.has_joint_damping:
         tau += model.D_m @ v[1:]
     return tau

@@ -60,8 +60,13 @@ class DampNullMotion:
 
     g_m: float  # 1/s
 
+    def __post_init__(self) -> None:
+        self._output = NullOutput(damping=self.g_m)  # the same every step: built once per g_m
+
     def __call__(self, t: float, cp: Coupling, q: np.ndarray, v: np.ndarray) -> NullOutput:
-        return NullOutput(damping=self.g_m)
+        if self._output.damping != self.g_m:
+            self._output = NullOutput(damping=self.g_m)
+        return self._output
 
     def retune(self, gains: Gains) -> None:
         self.g_m = gains.g_m
