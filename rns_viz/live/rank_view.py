@@ -52,12 +52,17 @@ def arm_pose(model: FsmsModel, theta: np.ndarray) -> np.ndarray:
     return np.array([base.rotation.T @ (p - base.translation) for p in points])
 
 
+def has_rank_inset(model: FsmsModel) -> bool:
+    """The model has a rank-loss overlay and inset: one arm of 2 or 3 joints."""
+    return not is_dual(model) and model.n in SEEDS_PER_JOINT
+
+
 @cache
 def rank_overlay(key: str) -> RankOverlay | None:
     """The overlay of a single-arm model (by model key) with 2 or 3 joints (None otherwise: a search over a
     larger joint grid is too slow to run on demand)."""
     model = FsmsModel.from_key(key)
-    if is_dual(model) or model.n not in SEEDS_PER_JOINT:
+    if not has_rank_inset(model):
         return None
     loss = rank_deficient_configurations(model, points_per_joint=SEEDS_PER_JOINT[model.n])
     poses = np.array([arm_pose(model, t) for t in loss.theta]).reshape(-1, model.n + 1, 3)

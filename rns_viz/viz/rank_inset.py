@@ -2,21 +2,24 @@
 
 Why an image and not a uPlot chart: the picture is a field (sigma_min(S H_bm) over the plane, log
 colour) with markers, which a uPlot line chart cannot draw. The field, the axes and the rank-loss
-markers are drawn once per plane with matplotlib (Agg) into an RGB array; each refresh (with the
-text, 5 Hz) only stamps the arm's configuration as a dot into a copy of it, with numpy, and sends the
-image when the dot moved (a ~300 px JPEG). Data: :func:`rns_viz.live.rank_view.rank_inset`, whose
+markers are drawn once per plane with matplotlib (Agg) into an RGB array, in a thread of its own
+(0.1-0.3 s: never in the render thread); each refresh (with the text, 5 Hz) only stamps the arm's
+configuration as a dot into a copy of it, with numpy, and sends the image when the dot moved (a
+~300 px JPEG). Data: :func:`rns_viz.live.rank_view.rank_inset`, whose
 configurations are the overlay's (each checked: sigma_min <= 1e-9 of the most coupled ||S H_bm||).
 """
 
 from __future__ import annotations
 
 import math
+import threading
+import traceback
 from dataclasses import dataclass
 
 import numpy as np
 import viser
 
-from rns_viz.live.rank_view import RANK_HINT, RankInset, inset_slice, rank_inset
+from rns_viz.live.rank_view import RANK_HINT, RankInset, has_rank_inset, inset_slice, rank_inset
 from rns_viz.live.records import Snapshot
 from rns_viz.model import FsmsModel
 from rns_viz.viz.view_toggles import ViewToggles
@@ -50,8 +53,10 @@ def draw_inset(data: RankInset, labels: tuple[str, str], title: str) -> InsetPic
     fig = Figure(figsize=(SIZE_PX / DPI, SIZE_PX / DPI), dpi=DPI)
     canvas = FigureCanvasAgg(fig)
     ax = fig.add_axes((0.17, 0.15, 0.78, 0.75))
-    deg = np.rad2deg(data.axis)
-    ax.pcolormesh(deg, deg, np.log10(np.maximum(data.sigma.T, 1e-4)), cmap="gray", vmin=-3.0, vmax=0.0)
+    half = 0.5 * float(np.rad2deg(data.axis[1] - data.axis[0]))  # the grid nodes are the pixels' centres
+    extent = (-180.0 - half, 180.0 + half, -180.0 - half, 180.0 + half)
+    field = np.log10(np.maximum(data.sigma.T, 1e-4))
+    ax.imshow(field, cmap="gray", vmin=-3.0, vmax=0.0, origin="lower", extent=extent, interpolation="nearest")
     marks = np.rad2deg(np.angle(np.exp(1j * data.theta[:, list(data.columns)])))
     filled, rings = marks[data.in_plane], marks[~data.in_plane]
     ax.scatter(filled[:, 0], filled[:, 1], s=60, color=MARK_COLOUR, edgecolors="black", zorder=3)
@@ -99,32 +104,50 @@ class RankInsetPanel:
         self.picture: InsetPicture | None = None  # what is drawn (tests read it)
         self.theta: np.ndarray | None = None  # the configuration the dot shows
         self.updates = 0  # images sent
-        self._plane: tuple[str, float | None] | None = None
+        self._plane: tuple[str, float | None] | None = None  # the plane of ``picture``
+        self._drawing: tuple[str, float | None] | None = None  # the plane being drawn in the background
+        self._lock = threading.Lock()
 
     def refresh(self, snap: Snapshot) -> None:
         key = snap.settings.model
         on = self.view.on("rank") and "rank" in self.view.boxes
         model = FsmsModel.from_key(key) if on else None
         theta = None if model is None else np.asarray(snap.q[model.m :], dtype=float)
-        plane = None if theta is None or not np.all(np.isfinite(theta)) else (key, inset_slice(key, theta))
-        data = None if plane is None else rank_inset(*plane)
-        if data is None:
+        drawable = model is not None and has_rank_inset(model) and theta is not None and np.all(np.isfinite(theta))
+        if not drawable:
             if self.folder.visible:
                 self.folder.visible = False
             return
-        assert model is not None and theta is not None and plane is not None
-        if plane != self._plane:
-            self._plane = plane
-            self.picture = draw_inset(data, *_words(model.n, plane[1]))
-            self.text.content = INSET_TEXT + _slice_words(model.n, plane[1]) + RANK_HINT
-            self.theta = None
-        assert self.picture is not None
+        assert model is not None and theta is not None
+        plane = (key, inset_slice(key, theta))
+        with self._lock:
+            picture = self.picture if plane == self._plane else None
+            if picture is None and self._drawing is None:  # draw the new plane in the background
+                self._drawing = plane
+                threading.Thread(target=self._draw, args=(model.n, plane), daemon=True).start()
+        if picture is None:
+            return  # the old picture stays until the new one is ready
         if self.theta is None or not np.allclose(theta, self.theta, atol=np.deg2rad(0.5)):
             self.theta = theta.copy()
-            self.image.image = with_dot(self.picture, theta)
+            self.image.image = with_dot(picture, theta)
             self.updates += 1
         if not self.folder.visible:
             self.folder.visible = True
+
+    def _draw(self, n: int, plane: tuple[str, float | None]) -> None:
+        try:
+            data = rank_inset(*plane)
+            assert data is not None
+            picture = draw_inset(data, *_words(n, plane[1]))
+            text = INSET_TEXT + _slice_words(n, plane[1]) + RANK_HINT
+        except Exception:  # drawing must never kill the app; the next refresh tries again
+            traceback.print_exc()
+            picture = None
+        with self._lock:
+            self._drawing = None
+            if picture is not None:
+                self.picture, self._plane, self.theta = picture, plane, None
+                self.text.content = text
 
 
 def _words(n: int, fixed: float | None) -> tuple[tuple[str, str], str]:
