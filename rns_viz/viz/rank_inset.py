@@ -30,7 +30,7 @@ DOT_RADIUS_PX = 5
 DOT_COLOUR = (31, 111, 209)  # the arm now: the charts' blue
 MARK_COLOUR = "#c87800"  # amber, as the overlay's poses
 INSET_TEXT = (
-    "Amber: where S H_bm loses rank (filled: in this plane; rings: the same joint angles at another θ₁). "
+    "Amber: where S H_bm loses rank. "
     "Blue dot: the arm now. Colour: σ_min(S H_bm) relative to its largest, dark where the joints barely push "
     "the base. "
 )
@@ -161,5 +161,5 @@ def _slice_words(n: int, fixed: float | None) -> str:
         return "The four poses are isolated points, not curves: one base row must vanish as a whole. "
     return (
         f"The 3R's plane is (θ₂, θ₃) through its θ₁ (now {math.degrees(fixed or 0.0):.0f}°, in 5° steps): its eight "
-        "poses have θ₁ = 0° or 180°, so they fill in only when the shoulder lies along the swing axis. "
+        "poses have θ₁ = 0° or 180°: filled, those in this plane; rings, the same (θ₂, θ₃) at another θ₁. "
     )
