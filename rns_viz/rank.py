@@ -119,9 +119,10 @@ def kernel_coupling(model: FsmsModel, theta: np.ndarray, columns: Sequence[int] 
 
 
 def sigma_grid(
-    model: FsmsModel, columns: Sequence[int], points_per_joint: int = 73
+    model: FsmsModel, columns: Sequence[int], points_per_joint: int = 73, theta: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """sigma_min(S H_bm) on a grid of two joints over [-pi, pi] (others at the default), for a contour inset.
+    """sigma_min(S H_bm) on a grid of two joints over [-pi, pi] (others at ``theta``, default: the model's
+    default configuration), for the joint-space inset.
 
     Returns the two axes (rad) and sigma_min (points_per_joint, points_per_joint), kg m (kg m^2);
     rank deficiency is its zero level.
@@ -130,7 +131,7 @@ def sigma_grid(
     if cols.size != 2:
         raise ValueError("sigma_grid draws two joints")
     axis = np.linspace(-np.pi, np.pi, points_per_joint)
-    theta = model.spec.default_configuration.copy()
+    theta = (model.spec.default_configuration if theta is None else np.asarray(theta, dtype=float)).copy()
     field = np.empty((axis.size, axis.size))
     for i, a in enumerate(axis):
         for j, b in enumerate(axis):

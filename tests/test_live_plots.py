@@ -51,7 +51,7 @@ def test_chart_options_never_change_with_presets_models_and_suppression() -> Non
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         s, plots = app.session, app.gui.plots
-        charts = [c for mode in plots.charts.values() for c in mode.values()] + [plots.error]
+        charts = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values()] + [plots.error]
         before = [_options(c) for c in charts]
         s.kick(0.8)
         s.advance(1.0)
@@ -124,5 +124,44 @@ def test_a_session_nobody_watched_restarts_for_its_first_visitor(monkeypatch: py
         assert s.snapshot().t == pytest.approx(0.5) and "Reset" not in s.pending_commands()
         first.close()
         second.close()
+    finally:
+        app.stop()
+
+
+def _legend(handle: object) -> tuple[str, ...]:
+    return tuple(s["label"] for s in handle._impl.props.series[1:])  # type: ignore[attr-defined]
+
+
+def test_legend_and_caption_name_the_two_runs_of_the_model_served_and_of_its_replay() -> None:
+    """trep2's runs are compensation on / compensator held still; TREP's stay suppression on / off."""
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    try:
+        plots = app.gui.plots
+        shown = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values() if c.visible]
+        assert len(shown) == 2 and all(_legend(c) == ("suppression on", "suppression off") for c in shown)
+        assert "suppression on" in plots.caption.content and "second arm" not in plots.caption.content
+        app.session.switch_model("trep2")
+        app.session.advance(0.01)
+        wait_until(lambda: plots.runs == "compensation", 20.0, "the trep2 panel")
+        shown = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values() if c.visible]
+        assert len(shown) == 2 and all(_legend(c) == ("compensation on", "compensator held still") for c in shown)
+        assert "held still" in plots.caption.content and "suppression on" not in plots.caption.content
+        assert "compensating" in plots.peaks.content and "suppression on" not in plots.peaks.content
+        s = app.session
+        s.set_target((0.05, 0.25), final=True)
+        s.advance(1.0)
+        s.start_replay(1.0)
+        s.advance(0.0)
+        wait_until(lambda: s.snapshot().replay is not None, 10.0, "the replay")
+        s.seek_replay(0.9)
+        s.advance(0.0)
+        wait_until(lambda: float(plots.xb.data[0][-1]) > 0.8, 10.0, "the replay's plots up to the playhead")
+        assert all(c.visible for c in shown)  # the replay fills trep2's charts, named for its runs
+        assert plots.xb in shown and _legend(plots.xb) == ("compensation on", "compensator held still")
+        app.session.switch_model("trep")
+        app.session.advance(0.01)
+        wait_until(lambda: plots.runs == "suppression", 20.0, "the TREP panel")
+        assert _legend(plots.xb) == ("suppression on", "suppression off") and plots.xb.visible
+        assert "suppression on" in plots.caption.content
     finally:
         app.stop()

@@ -16,7 +16,6 @@ For a model with ``[arms]`` (trep2) the live session runs :class:`~rns_viz.contr
 
 from __future__ import annotations
 
-import math
 from functools import cache
 
 import numpy as np
@@ -24,9 +23,8 @@ import pinocchio as pin
 
 from rns_viz.control import ControlOutput, Gains, TaskSample
 from rns_viz.control.compensation import CompensatingLaw
-from rns_viz.live.follower import Follower
+from rns_viz.live.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField
 
 WORKSPACE_MARGIN = 0.03  # fraction of the task arm's reach kept clear of its outer and inner boundary
 CANCEL_FLOOR = 1e-4  # kg m/s: below this task-arm momentum there is nothing to cancel
@@ -103,7 +101,7 @@ class TaskWorkspace:
         return self.center + float(np.clip(r, self.inner, self.outer)) * direction, True
 
 
-class TaskTarget:
+class TaskTarget(SmoothedTarget):
     """The task arm's reference for the operator: the dragged target smoothed by a :class:`Follower`
     (speed ``v_max`` m/s), with its rates x_d', x_d'' for resolved-acceleration tracking.
 
@@ -113,31 +111,12 @@ class TaskTarget:
     """
 
     def __init__(self, model: FsmsModel, theta: np.ndarray, v_max: float = 0.1) -> None:
-        self.model = model
-        self.field = CouplingField(model)
+        super().__init__(model, 2, v_max)
         self.workspace = TaskWorkspace(model)
-        self.follower = Follower(np.zeros(2), v_max)
-        self.blocked = False
-        self.sigma_jbar = math.nan
         self.reset(theta)
 
     def ee(self, theta: np.ndarray) -> np.ndarray:
         return self.model.ee_position(theta)[:2]
-
-    def reset(self, theta: np.ndarray, keep_goal: bool = False) -> None:
-        self.theta = np.array(theta, dtype=float)
-        self.level = self.field.potentials(self.theta[None])
-        x = self.ee(self.theta)
-        self.follower.reset(x)
-        if not keep_goal:
-            self.goal = x.copy()
-        self.thetadot = np.zeros_like(self.theta)
-        self.x, self.xdot, self.xddot = x, np.zeros(2), np.zeros(2)
-        self.idle = not keep_goal
-
-    def set_goal(self, goal: np.ndarray) -> None:
-        self.goal = np.array(goal, dtype=float)[:2]
-        self.idle = False
 
     def step(self, dt: float) -> None:
         """x_d(t), x_d'(t), x_d''(t) for the step at t (called once before it)."""

@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from rns_viz.live.follower import Follower, ScalarFollower
+from rns_viz.live.follower import ScalarFollower
+from rns_viz.live.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic
@@ -183,7 +184,7 @@ class PathFollower:
         return out
 
 
-class ResolvedRate:
+class ResolvedRate(SmoothedTarget):
     """Reactionless resolved-rate reference for a multi-dimensional RNS (the planar 3R).
 
     The operator's target is smoothed by a :class:`Follower` (speed ``v_max`` m/s), then
@@ -207,32 +208,20 @@ class ResolvedRate:
         stop_sigma: float = 0.08,
         joint_speed: float = 1.0,
     ) -> None:
-        self.model = model
+        self.rows = model.task_rows
+        super().__init__(model, len(self.rows), v_max)
         self.data = model.pin_model.createData()
-        self.field = CouplingField(model)
         self.k = k
         self.threshold = threshold
         self.leash = leash  # m: the smoothed target waits when it gets this far ahead of the reference
         self.stop_sigma = stop_sigma  # m/rad: no motion that lowers sigma_min(J-bar) below this
         self.joint_speed = joint_speed  # rad/s: |theta_ref'| at most
-        self.blocked = False
-        self.rows = model.task_rows
-        self.follower = Follower(np.zeros(len(self.rows)), v_max)
         self.reset(theta)
 
     def reset(self, theta: np.ndarray, keep_goal: bool = False) -> None:
-        self.theta = np.array(theta, dtype=float)
-        self.level = self.field.potentials(self.theta[None])
-        x = self.ee(self.theta)
-        self.follower.reset(x)
-        if not keep_goal:
-            self.goal = x.copy()
-        self.thetadot = np.zeros_like(self.theta)
-        self.x, self.xdot, self.xddot = x, np.zeros_like(x), np.zeros_like(x)
-        self.sigma_jbar = float("nan")
+        super().reset(theta, keep_goal)
         self._steps = 0
         self._next: np.ndarray | None = None
-        self.idle = not keep_goal
 
     def _projector(self, q: np.ndarray) -> np.ndarray:
         """P_RNS at q, from S H_bm."""
@@ -253,10 +242,6 @@ class ResolvedRate:
         pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
         base = data.oMi[self.model.base_joint_id]
         return (base.rotation.T @ (data.oMf[self.model.ee_frame_id].translation - base.translation))[self.rows]
-
-    def set_goal(self, goal: np.ndarray) -> None:
-        self.goal = np.array(goal, dtype=float)[: len(self.rows)]
-        self.idle = False
 
     def step(self, dt: float) -> None:
         """Commit the last integration step, then set (theta', x, x', x'') at the new theta_ref.

@@ -32,6 +32,7 @@ from rns_viz.viz.lesson_panel import LessonPanel
 from rns_viz.viz.model_menu import ModelMenu
 from rns_viz.viz.path_words import PathWords
 from rns_viz.viz.pictures import Pictures
+from rns_viz.viz.rank_inset import RankInsetPanel
 from rns_viz.viz.render import TARGET_HANDLE, Renderer
 from rns_viz.viz.replay_panel import ReplayPanel
 from rns_viz.viz.scene import FsmsScene
@@ -62,6 +63,7 @@ class RnsApp:
         self.controls = Controls(self.gui, session, self.connections)
         self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
         self.view = make_view_toggles(server, self.connections)
+        self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
         self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
         self.renderer = Renderer(
             server, session, self.gui, self.controls, self.connections, self.view, base_panel=self.base_panel
@@ -70,7 +72,7 @@ class RnsApp:
         self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
         self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
         self.replay = ReplayPanel(server, session, self.controls, self.connections, self.view)
-        self.renderer.text_panels.append(self.replay.refresh)
+        self.renderer.text_panels += [self.replay.refresh, self.rank_inset.refresh]
         # each page gets updates at the rate it can draw; told so under the status line when slowed
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
         server.on_client_connect(self._client_joined)

@@ -5,8 +5,9 @@ component rebuilds a chart whose options change, and when that rebuild lands in 
 frame as new data it keeps the destroyed chart's x range as a *relative* zoom, which pins the time
 axis far outside the data (e.g. 50-150 s) in every tab until a reload. So nothing but data is ever
 sent to a chart; the meaning of the colours is fixed (blue: suppression on, red: off, whichever run
-is operated), the y scale is chosen by showing one of two prebuilt charts (a new chart mounts
-fresh), and the peaks are HTML beside them.
+is operated; for a model with a compensating arm, blue: compensation on, red: compensator held
+still), the y scale and the legend's names are chosen by showing one of the prebuilt charts (a new
+chart mounts fresh), and the peaks are HTML beside them.
 """
 
 from __future__ import annotations
@@ -45,7 +46,12 @@ def on_off(arrays: dict[str, np.ndarray], key: str) -> tuple[np.ndarray, np.ndar
 
 
 def _chart(
-    gui: viser.GuiApi, title: str, y_label: str, curves: tuple[tuple[str, str], ...], y_scale: viser.uplot.Scale
+    gui: viser.GuiApi,
+    title: str,
+    y_label: str,
+    curves: tuple[tuple[str, str], ...],
+    y_scale: viser.uplot.Scale,
+    visible: bool = True,
 ) -> viser.GuiUplotHandle:
     series: list[viser.uplot.Series] = [{"label": "t (s)"}]
     series += [{"label": label, "stroke": colour, "width": 1.5} for label, colour in curves]
@@ -61,15 +67,17 @@ def _chart(
         cursor={"show": False},
         aspect=2.1,
         padding=(4, 16, 0, 0),
+        visible=visible,
     )
 
 
-ON_OFF = (("suppression on", ON_COLOUR), ("suppression off", OFF_COLOUR))
 PLOTS_CAPTION = (
     '<div style="font-size:0.75em;opacity:0.8">The last 10 s: how far the base is bent, x_b (µm); the momentum '
-    "the arm's joints hand to the base, L (mN·s = g·m/s); how far the hand is from where it is sent, |e| (mm).</div>"
+    "the arm's joints hand to the base, L (mN·s = g·m/s); how far the hand is from where it is sent, |e| (mm). "
+    "{runs}</div>"
 )
-# (blue header, red header, note) of the peaks table: one arm (suppression) or two (compensation)
+# (blue header, red header, note) of the peaks table, the legend's two names and the caption's sentence on
+# the two runs: one arm (suppression) or two (compensation)
 SUPPRESSION_SIDES = (
     "suppression on",
     "suppression off",
@@ -78,9 +86,20 @@ SUPPRESSION_SIDES = (
 COMPENSATION_SIDES = (
     "compensating",
     "compensator held",
-    "|e|: the operated run. Blue (the charts' 'suppression on') is always the run whose second arm cancels "
-    "the reaction, red the one whose second arm is held still; the other run is the shadow run.",
+    "|e|: the operated run. Blue is always the run whose second arm cancels the reaction, red the one whose "
+    "second arm is held still; the other run is the shadow run.",
 )
+RUNS = ("suppression", "compensation")
+LEGEND = {
+    "suppression": (("suppression on", ON_COLOUR), ("suppression off", OFF_COLOUR)),
+    "compensation": (("compensation on", ON_COLOUR), ("compensator held still", OFF_COLOUR)),
+}
+RUNS_SENTENCE = {
+    "suppression": "Blue: vibration suppression on; red: off (one of them is the shadow run).",
+    "compensation": "Blue: the second arm cancels the task arm's reaction (compensation on); red: the same task "
+    "with the second arm held still (one of them is the shadow run).",
+}
+SIDES = {"suppression": SUPPRESSION_SIDES, "compensation": COMPENSATION_SIDES}
 
 
 class LivePlots:
@@ -88,17 +107,20 @@ class LivePlots:
 
     def __init__(self, gui: viser.GuiApi) -> None:
         linear: viser.uplot.Scale = {"auto": True}
-        self.caption = gui.add_html(PLOTS_CAPTION)  # charts take no hint: their meaning in plain words
-        self.charts: dict[str, dict[str, viser.GuiUplotHandle]] = {}
-        for mode in SCALES:
-            xb_scale, L_scale = linear, linear
-            if mode == "symlog":
-                xb_scale = {"auto": False, "distr": 4, "asinh": XB_SYMLOG[1], "range": (-XB_SYMLOG[0], XB_SYMLOG[0])}
-                L_scale = {"auto": False, "distr": 4, "asinh": L_SYMLOG[1], "range": (-L_SYMLOG[0], L_SYMLOG[0])}
-            self.charts[mode] = {
-                "xb": _chart(gui, "Base deflection", "x_b (µm)", ON_OFF, xb_scale),
-                "L": _chart(gui, "Coupling momentum", "L (mN·s)", ON_OFF, L_scale),
-            }
+        # charts take no hint: their meaning in plain words
+        self.caption = gui.add_html(PLOTS_CAPTION.format(runs=RUNS_SENTENCE["suppression"]))
+        # runs -> scale -> chart: one set of charts per legend (a chart's series names cannot change)
+        self.chart_sets: dict[str, dict[str, dict[str, viser.GuiUplotHandle]]] = {runs: {} for runs in RUNS}
+        for runs in RUNS:
+            for mode in SCALES:
+                xb_scale, L_scale = linear, linear
+                if mode == "symlog":
+                    xb_scale = _symlog(XB_SYMLOG)
+                    L_scale = _symlog(L_SYMLOG)
+                self.chart_sets[runs][mode] = {
+                    "xb": _chart(gui, "Base deflection", "x_b (µm)", LEGEND[runs], xb_scale, visible=False),
+                    "L": _chart(gui, "Coupling momentum", "L (mN·s)", LEGEND[runs], L_scale, visible=False),
+                }
         self.error = _chart(gui, "End-effector error", "|e| (mm)", (("|x_ref − x_e|", ERROR_COLOUR),), linear)
         self.peaks = gui.add_html(peaks_html(None))
         self.scale = gui.add_dropdown(
@@ -109,8 +131,32 @@ class LivePlots:
             "millimetres (fig11-fast against fig11-joint2).",
         )
         self.mode = "linear"
-        self.sides = SUPPRESSION_SIDES  # the peaks table's headers (the app sets them per model)
+        self.runs = "suppression"  # what the two runs are: the app sets it per model (``sides``)
         self.show_mode("linear")
+
+    @property
+    def charts(self) -> dict[str, dict[str, viser.GuiUplotHandle]]:
+        """The charts of the model's two runs, by scale."""
+        return self.chart_sets[self.runs]
+
+    @property
+    def sides(self) -> tuple[str, str, str]:
+        """The peaks table's headers and note."""
+        return SIDES[self.runs]
+
+    @sides.setter
+    def sides(self, sides: tuple[str, str, str]) -> None:
+        """Name the two runs for the model served: the peaks table, the caption and the charts' legend."""
+        self.show_runs(next(runs for runs, s in SIDES.items() if s == sides))
+
+    def show_runs(self, runs: str) -> None:
+        """Show the charts whose legend names ``runs`` ('suppression' or 'compensation') and say it above them."""
+        if runs == self.runs:
+            return
+        self.runs = runs
+        self.caption.content = PLOTS_CAPTION.format(runs=RUNS_SENTENCE[runs])
+        self.peaks.content = peaks_html(None, self.sides)  # the new runs' names until their first data
+        self.show_mode(self.mode)
 
     @property
     def xb(self) -> viser.GuiUplotHandle:
@@ -123,9 +169,10 @@ class LivePlots:
     def show_mode(self, mode: str) -> None:
         """Show the charts of scale ``mode`` (a hidden chart unmounts; shown again it mounts fresh)."""
         self.mode = mode
-        for name, charts in self.charts.items():
-            for chart in charts.values():
-                chart.visible = name == mode
+        for runs, sets in self.chart_sets.items():
+            for name, charts in sets.items():
+                for chart in charts.values():
+                    chart.visible = name == mode and runs == self.runs
 
     def update(self, arrays: dict[str, np.ndarray]) -> bool:
         """Send the arrays (PLOT_SERIES of the session) to the shown charts; False if too few samples."""
@@ -150,6 +197,11 @@ class LivePlots:
         if self.peaks.content != content:
             self.peaks.content = content
         return True
+
+
+def _symlog(limits: tuple[float, float]) -> viser.uplot.Scale:
+    """A fixed symmetric-log scale: (range, linear threshold) in display units."""
+    return {"auto": False, "distr": 4, "asinh": limits[1], "range": (-limits[0], limits[0])}
 
 
 def _clean(x: np.ndarray) -> np.ndarray:
