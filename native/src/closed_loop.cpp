@@ -162,10 +162,12 @@ double ClosedLoop::coupling(const ConstRef& q, const ConstRef& v, Ref L) {
   H_bm_.resize(r_, n_);
   H_b_.resize(r_, r_);
   xdot_b_.resize(r_);
+  base_momentum_.resize(r_);
   hbm_dot_s_.resize(r_);
   for (Index i = 0; i < r_; ++i) {
     H_bm_.row(i) = M_.row(rows_[i]).tail(n_);
     xdot_b_(i) = v(rows_[i]);
+    base_momentum_(i) = M_.row(rows_[i]).head(m_).dot(v.head(m_));  // all m velocities: S selects rows only
     hbm_dot_s_(i) = hbm_dot(rows_[i]);
     for (Index j = 0; j < r_; ++j) H_b_(i, j) = M_(rows_[i], rows_[j]);
   }
@@ -185,7 +187,7 @@ double ClosedLoop::coupling(const ConstRef& q, const ConstRef& v, Ref L) {
   return sigma;
 }
 
-// Eq. (15): theta'' = H_bm^+ (H_b G_b x_b' - H_bm' theta' - G_m L) + P u, P u = u - H_bm^+ (H_bm u).
+// Eq. (15): theta'' = H_bm^+ (S H_b G_b x_b' - H_bm' theta' - G_m L) + P u, P u = u - H_bm^+ (H_bm u).
 
 // Without a reference u = -k_d theta' (DampNullMotion; k_p unused).
 
@@ -198,7 +200,7 @@ double ClosedLoop::composite(const ConstRef& x, double g_b, double g_m, double k
   VectorXd u = -k_d * thetadot;
   if (ref != nullptr) u += *ref->thetaddot + k_d * *ref->thetadot + k_p * (*ref->theta - q.tail(n_));
   const VectorXd Pu = u - pinv_ * (H_bm_ * u);
-  realize(q, v, pinv_ * (g_b * (H_b_ * xdot_b_) - hbm_dot_s_ - g_m * L) + Pu, tau);
+  realize(q, v, pinv_ * (g_b * base_momentum_ - hbm_dot_s_ - g_m * L) + Pu, tau);
   return sigma;
 }
 

@@ -154,6 +154,14 @@ class Coupling:
         return self.M[self._H_b_index]
 
     @property
+    def base_momentum(self) -> np.ndarray:
+        """(r,) S H_b x_b': the selected rows of H_b times all m base velocities (kg m/s, kg m^2/s).
+
+        S selects rows only (Sec. III-B): the free components' velocities enter through H_b's
+        off-diagonal block, which S H_b S^T x_b' would drop (see README, forces-only suppression)."""
+        return self.M[self._rows, : self._m].dot(self._v[: self._m])
+
+    @property
     def hbm_dot_thetadot(self) -> np.ndarray:
         """(r,) S H_bm' theta'."""
         return self._hbm_dot[self._rows]
