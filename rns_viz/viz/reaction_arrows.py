@@ -12,7 +12,7 @@ import viser
 
 from rns_viz.viz.style import SceneStyle
 
-MOMENT_COLOUR = (120, 0, 160)  # purple-red, apart from the force's red
+MOMENT_COLOUR = (200, 0, 140)  # magenta: apart from the force's red and the coupling momentum's purple
 
 
 class WrenchArrows:
