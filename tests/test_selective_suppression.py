@@ -3,6 +3,7 @@ is S H_b G_b x_b' with all six base velocities (Sec. III-B applied to Eq. 12). W
 the linearised closed loop is then stable over the whole gain map, and on the `boom7-track` preset held
 past its motion the free torsion decays with suppression on (it grew x1.4 per second when the law used
 the selected block S H_b S^T of the base inertia, i.e. dropped the free coordinates' velocities).
+Laws (16) and (30) read S the same way.
 """
 
 from __future__ import annotations
@@ -53,6 +54,16 @@ def test_linearised_loop_is_stable_over_the_gain_map(boom: FsmsModel, selection:
         loop = linearise(model, "15", theta)
         slowest = loop.poles(g_b, g_m).real.max(axis=-1)  # 1/s
         assert slowest.max() < -0.03, (selection, slowest.max())  # the boom's own damping is 0.05 /s
+
+
+@pytest.mark.parametrize("law", ["16", "30"])
+def test_the_other_suppression_laws_are_stable_with_forces_only(boom: FsmsModel, law: str) -> None:
+    """(16) and (30) take S H_b G_b x_b' and S H_b g_b x_b the same way; with the selected block they were
+    unstable from g_b = 10 /s (g_m = 2 /s) on boom7 with forces only."""
+    model = boom.with_selection(FORCES_ONLY)
+    g_b, g_m = np.meshgrid(np.logspace(-1, 2, 10), np.logspace(0, 2, 5))
+    slowest = linearise(model, law).poles(g_b, g_m).real.max(axis=-1)  # 1/s
+    assert slowest.max() < -0.01, slowest.max()
 
 
 def test_forces_only_tracking_held_past_its_motion_lets_the_torsion_decay() -> None:

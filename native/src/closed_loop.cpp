@@ -96,7 +96,7 @@ double ClosedLoop::tracking_step(const ConstRef& x, double g_b, double g_m, doub
 
 // Returns (sigma_min(S H_bm), sigma_min(J-bar)).
 
-// Eq. (30): theta'_cmd = H_bm^+ H_b g_b x_b + g_m (theta_r - theta) [+ theta_r'], then the servo.
+// Eq. (30): theta'_cmd = H_bm^+ S H_b g_b x_b + g_m (theta_r - theta) [+ theta_r'], then the servo.
 
 double ClosedLoop::velocity_control(const ConstRef& x, double g_b, double g_m, double w_s, bool feedforward,
                         const ConstRef& theta_r, const ConstRef& thetadot_r, Ref tau, Ref L) {
@@ -105,9 +105,9 @@ double ClosedLoop::velocity_control(const ConstRef& x, double g_b, double g_m, d
   const ConstRef q = x.head(nv_);
   const ConstRef v = x.tail(nv_);
   const double sigma = coupling(q, v, L);
-  VectorXd x_b(r_);
-  for (Index i = 0; i < r_; ++i) x_b(i) = q(rows_[i]);
-  VectorXd cmd = pinv_ * (g_b * (H_b_ * x_b)) + g_m * (theta_r - q.tail(n_));
+  VectorXd Hb_x_b(r_);  // S H_b x_b with every base coordinate: S selects rows only, as in (15)
+  for (Index i = 0; i < r_; ++i) Hb_x_b(i) = M_.row(rows_[i]).head(m_).dot(q.head(m_));
+  VectorXd cmd = pinv_ * (g_b * Hb_x_b) + g_m * (theta_r - q.tail(n_));
   if (feedforward) cmd += thetadot_r;
   realize(q, v, w_s * (cmd - v.tail(n_)), tau);
   return sigma;

@@ -154,6 +154,11 @@ class Coupling:
         return self.M[self._H_b_index]
 
     @property
+    def H_b_rows(self) -> np.ndarray:
+        """(r, m) S H_b: the selected rows of the base inertia, every column (kg, kg m, kg m^2)."""
+        return self.M[self._rows, : self._m]
+
+    @property
     def base_momentum(self) -> np.ndarray:
         """(r,) S H_b x_b': the selected rows of H_b times all m base velocities (kg m/s, kg m^2/s).
 
