@@ -65,6 +65,11 @@ ACTIONS: dict[tuple[str, int], Callable[[RnsApp], None]] = {
     ("planar3r", 1): lambda app: app.session.set_target(_ee(app) + np.array([0.0, 0.3]), True),
     ("planar3r", 2): lambda app: app.session.set_target(np.array([2.5, 2.0]), True),
     ("planar3r", 3): lambda app: app.session.kick(3.0),
+    ("boom7", 1): lambda app: app.session.kick(5.0, direction=(0.0, 1.0, 0.0, 0.0, 0.0, 0.0)),
+    ("boom7", 2): lambda app: app.session.scrub(0.5 * app.session.snapshot().sigma_range[0]),  # type: ignore[index]
+    ("boom7", 3): lambda app: app.session.set_target(
+        np.asarray(app.session.snapshot().target) + np.array([0.04, -0.02, 0.02]), True
+    ),
 }
 GHOSTS = {("trep", 4): "ghost_trep", ("planar3r", 3): "ghost_planar3r"}
 
@@ -80,7 +85,7 @@ def shoot(page: Page, name: str) -> Path:
     return path
 
 
-@pytest.mark.parametrize("model", ["trep", "planar3r"])
+@pytest.mark.parametrize("model", ["trep", "planar3r", "boom7"])
 def test_walk_every_lesson_with_screenshots(model: str) -> None:
     app = start_app(model, port=0, verbose=False, lesson=1)
     try:

@@ -65,7 +65,6 @@ def test_scrubbing_the_reactionless_path_moves_the_hand_and_not_the_boom(boom: S
 
 def test_forces_only_tracks_a_3d_target_and_an_unserved_selection_is_refused(boom: Session) -> None:
     s = boom
-    s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (see README)
     s.set_selection((True, True, True, False, False, False))
     s.advance(0.01)
     told = [n for n in s.pop_notices() if n.title == "Selection S"]

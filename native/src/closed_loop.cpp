@@ -96,7 +96,7 @@ double ClosedLoop::tracking_step(const ConstRef& x, double g_b, double g_m, doub
 
 // Returns (sigma_min(S H_bm), sigma_min(J-bar)).
 
-// Eq. (30): theta'_cmd = H_bm^+ H_b g_b x_b + g_m (theta_r - theta) [+ theta_r'], then the servo.
+// Eq. (30): theta'_cmd = H_bm^+ S H_b g_b x_b + g_m (theta_r - theta) [+ theta_r'], then the servo.
 
 double ClosedLoop::velocity_control(const ConstRef& x, double g_b, double g_m, double w_s, bool feedforward,
                         const ConstRef& theta_r, const ConstRef& thetadot_r, Ref tau, Ref L) {
@@ -105,9 +105,9 @@ double ClosedLoop::velocity_control(const ConstRef& x, double g_b, double g_m, d
   const ConstRef q = x.head(nv_);
   const ConstRef v = x.tail(nv_);
   const double sigma = coupling(q, v, L);
-  VectorXd x_b(r_);
-  for (Index i = 0; i < r_; ++i) x_b(i) = q(rows_[i]);
-  VectorXd cmd = pinv_ * (g_b * (H_b_ * x_b)) + g_m * (theta_r - q.tail(n_));
+  VectorXd Hb_x_b(r_);  // S H_b x_b with every base coordinate: S selects rows only, as in (15)
+  for (Index i = 0; i < r_; ++i) Hb_x_b(i) = M_.row(rows_[i]).head(m_).dot(q.head(m_));
+  VectorXd cmd = pinv_ * (g_b * Hb_x_b) + g_m * (theta_r - q.tail(n_));
   if (feedforward) cmd += thetadot_r;
   realize(q, v, w_s * (cmd - v.tail(n_)), tau);
   return sigma;
@@ -162,10 +162,12 @@ double ClosedLoop::coupling(const ConstRef& q, const ConstRef& v, Ref L) {
   H_bm_.resize(r_, n_);
   H_b_.resize(r_, r_);
   xdot_b_.resize(r_);
+  base_momentum_.resize(r_);
   hbm_dot_s_.resize(r_);
   for (Index i = 0; i < r_; ++i) {
     H_bm_.row(i) = M_.row(rows_[i]).tail(n_);
     xdot_b_(i) = v(rows_[i]);
+    base_momentum_(i) = M_.row(rows_[i]).head(m_).dot(v.head(m_));  // all m velocities: S selects rows only
     hbm_dot_s_(i) = hbm_dot(rows_[i]);
     for (Index j = 0; j < r_; ++j) H_b_(i, j) = M_(rows_[i], rows_[j]);
   }
@@ -185,7 +187,7 @@ double ClosedLoop::coupling(const ConstRef& q, const ConstRef& v, Ref L) {
   return sigma;
 }
 
-// Eq. (15): theta'' = H_bm^+ (H_b G_b x_b' - H_bm' theta' - G_m L) + P u, P u = u - H_bm^+ (H_bm u).
+// Eq. (15): theta'' = H_bm^+ (S H_b G_b x_b' - H_bm' theta' - G_m L) + P u, P u = u - H_bm^+ (H_bm u).
 
 // Without a reference u = -k_d theta' (DampNullMotion; k_p unused).
 
@@ -198,7 +200,7 @@ double ClosedLoop::composite(const ConstRef& x, double g_b, double g_m, double k
   VectorXd u = -k_d * thetadot;
   if (ref != nullptr) u += *ref->thetaddot + k_d * *ref->thetadot + k_p * (*ref->theta - q.tail(n_));
   const VectorXd Pu = u - pinv_ * (H_bm_ * u);
-  realize(q, v, pinv_ * (g_b * (H_b_ * xdot_b_) - hbm_dot_s_ - g_m * L) + Pu, tau);
+  realize(q, v, pinv_ * (g_b * base_momentum_ - hbm_dot_s_ - g_m * L) + Pu, tau);
   return sigma;
 }
 

@@ -168,7 +168,7 @@ class ClosedLoop {
   VectorXd u_, stage_, slope_sum_;
   // the law's terms at the current state (coupling())
   MatrixXd M_, H_bm_, H_b_, pinv_;
-  VectorXd c_, xdot_b_, hbm_dot_s_;
+  VectorXd c_, xdot_b_, hbm_dot_s_, base_momentum_;  // base_momentum_: S H_b x_b' (Eq. 15, S on rows)
 };
 
 }  // namespace rns_native

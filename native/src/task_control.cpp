@@ -52,7 +52,7 @@ std::pair<double, double> ClosedLoop::task_control(const ConstRef& x, double g_b
   const MatrixXd G = J_bar * J_bar.transpose() + lam2 * MatrixXd::Identity(p, p);
   const VectorXd rhs = xddot_d + G_d * edot + G_p * e - Jdot_thetadot + J * (pinv_ * hbm_dot_s_);
   const VectorXd Pu = J_bar.transpose() * G.partialPivLu().solve(rhs);
-  realize(q, v, pinv_ * (g_b * (H_b_ * xdot_b_) - hbm_dot_s_ - g_m * L) + Pu, tau);
+  realize(q, v, pinv_ * (g_b * base_momentum_ - hbm_dot_s_ - g_m * L) + Pu, tau);
   return {sigma, sigma_jbar};
 }
 

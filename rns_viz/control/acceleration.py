@@ -26,20 +26,21 @@ def composite_acceleration(cp: Coupling, g_b: float, g_m: float, null: NullOutpu
     -G_m L is the law's -G_m (E - P) theta', because (E - P) theta' = H_bm^+ H_bm theta' = H_bm^+ L
     (Eqs. 8, 9), also with the damped inverse.
     """
-    if cp.row is not None:
+    if cp.row is not None:  # a 1-DOF base: its one row in Python floats
         return _one_coupling_row(cp, g_b, g_m, null)
     return _any_coupling_rows(cp, g_b, g_m, null)
 
 
 def _any_coupling_rows(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
-    """Eq. (15) for any number of coupling rows, as written above."""
-    y = g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum
+    """Eq. (15) for any number of coupling rows, as written above, with S on the rows of H_b:
+    S H_b G_b x_b' (:attr:`Coupling.base_momentum`), so that S [H_b (x_b'' + G_b x_b') + K_b x_b] = 0 (Eq. 13)."""
+    y = g_b * cp.base_momentum - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum
     return cp.H_bm_pinv @ y + null.in_rns(cp)
 
 
 def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
-    """Eq. (15) for one coupling row h (a 1-DOF base), in the Python floats of ``cp.row`` (cheaper than
-    numpy calls here).
+    """Eq. (15) for the coupling row h of a 1-DOF base (S H_b x_b' = H_b x_b'), in the Python floats of
+    ``cp.row`` (cheaper than numpy calls here).
 
     The damped h^+ is h^T s, s = 1 / (|h|^2 + lambda^2), and the input's P (u - g_u theta')
     = u - g_u theta' - h^+ (h u - g_u L) joins the factor of h^+:

@@ -91,11 +91,11 @@ class ControlLaw(Protocol):
 
 
 class CouplingRow(NamedTuple):
-    """A one-row coupling (r = 1, e.g. a 1-DOF base) in Python floats, read by the one-row branches of
+    """The coupling of a 1-DOF base (one row) in Python floats, read by the one-row branches of
     Eq. (15) and Fig. 1: for a few joints, numbers cost less than numpy calls on tiny arrays."""
 
-    H_b: float  # selected diagonal entry of the base inertia
-    xdot_b: float  # selected base velocity, m/s
+    H_b: float  # the base inertia (1 x 1)
+    xdot_b: float  # the base velocity, m/s
     hbm_dot_thetadot: float  # S H_bm' theta'
     L: float  # S H_bm theta', Eq. (8)
     h: list[float]  # (n,) S H_bm
@@ -170,6 +170,19 @@ class Coupling:
         return self.M[self._H_b_index]
 
     @property
+    def H_b_rows(self) -> np.ndarray:
+        """(r, m) S H_b: the selected rows of the base inertia, every column (kg, kg m, kg m^2)."""
+        return self.M[self._rows, : self._m]
+
+    @property
+    def base_momentum(self) -> np.ndarray:
+        """(r,) S H_b x_b': the selected rows of H_b times all m base velocities (kg m/s, kg m^2/s).
+
+        S selects rows only (Sec. III-B): the free components' velocities enter through H_b's
+        off-diagonal block, which S H_b S^T x_b' would drop (see README, forces-only suppression)."""
+        return self.M[self._rows, : self._m].dot(self._v[: self._m])
+
+    @property
     def hbm_dot_thetadot(self) -> np.ndarray:
         """(r,) S H_bm' theta'."""
         return self._hbm_dot[self._rows]
@@ -220,7 +233,9 @@ class CouplingEvaluator:
         scale = float(np.linalg.svd(model.coupling_matrix(q0), compute_uv=False)[-1])
         self.threshold = singular_threshold if singular_threshold is not None else 0.1 * max(scale, 1e-9)
         self.max_damping = self.threshold
-        self._row = int(self.rows[0]) if len(self.rows) == 1 else None  # the one selected row
+        # A 1-DOF base's one row in Python floats. Not one selected row of a larger base: S acts on the
+        # rows of H_b, so S H_b x_b' needs every base velocity, not the selected diagonal entry.
+        self._row = 0 if m == 1 else None
 
     def __call__(self, q: np.ndarray, v: np.ndarray) -> Coupling:
         M, c, hbm_dot = self.model.dynamics(q, v)

@@ -28,7 +28,7 @@ class TorqueLaw(CompositeLaw):
         g_b = self.suppression_gain(t)
         null = self.null_input(t, cp, q, v)
         c_b = cp.c[:m][self.model.selected]
-        vib = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.xdot_b) - c_b)
+        vib = cp.H_bm_pinv @ (g_b * cp.base_momentum - c_b)  # S H_b G_b x_b', S on rows only as in (15)
         arm = null.in_rns(cp) - self.gains.g_m * (cp.thetadot - cp.project(cp.thetadot))
         tau = cp.H_m @ (vib + arm) + cp.c[m:] + self.model.D_m @ cp.thetadot
         return ControlOutput(

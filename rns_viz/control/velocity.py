@@ -63,7 +63,8 @@ class VelocityLaw:
         cp = self.coupling(q, v)
         theta_r, thetadot_r, _ = self.reference(t)
         g_b = self.suppression_gain(t)
-        cmd = cp.H_bm_pinv @ (g_b * (cp.H_b @ cp.x_b)) + self.gains.g_m * (theta_r - cp.theta)
+        # S H_b g_b x_b with every base coordinate (S on rows only, as in (15))
+        cmd = cp.H_bm_pinv @ (g_b * (cp.H_b_rows @ q[: self.model.m])) + self.gains.g_m * (theta_r - cp.theta)
         if self.feedforward:
             cmd = cmd + thetadot_r
         return cmd, theta_r, cp

@@ -65,4 +65,7 @@ def run_view(
         sigma_hbm=sigma,
         ee_target=target,
         targets_moved=counts[1],
+        base=runs.sim.q[: model.m].copy(),
+        base_shadow=runs.shadow.q[: model.m].copy() if shadow else None,
+        thetadot=runs.sim.v[model.m :].copy(),
     )

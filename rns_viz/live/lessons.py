@@ -10,76 +10,11 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.control import LawKind
-from rns_viz.model import FsmsModel
-
-
-@dataclass(frozen=True)
-class RunView:
-    """What a check may look at after a step (SI units; x_b the base deflection along S's first row)."""
-
-    epoch: int
-    t: float  # s
-    x_b: float  # m, operated run
-    x_b_shadow: float  # m, the shadow run (nan without it)
-    theta: np.ndarray  # rad
-    ee: np.ndarray  # (x, y) m, base frame
-    mode: str  # what the operator's reference is doing
-    kicks: int  # kicks since the lesson started
-    sigma_hbm: float  # kg m, smallest singular value of S H_bm
-    ee_target: np.ndarray | None  # (x, y) m, where the arm is sent; None without one
-    targets_moved: int  # dragged targets moved onto the path / into the reachable set so far
-
-
-@dataclass(frozen=True)
-class Progress:
-    done: bool
-    message: str  # for the student: what is measured now
-
-
-class Check:
-    """Observes runs; subclasses keep what they need and say :meth:`progress`."""
-
-    def __init__(self, model: FsmsModel) -> None:
-        self.model = model
-        H_b = float(model.mass_matrix(model.q(model.spec.default_configuration))[0, 0])
-        self.period = 2 * math.pi * math.sqrt(H_b / float(model.K_b[0, 0]))  # s, the base's swing
-        self.sigma0 = float(np.linalg.svd(model.coupling_matrix(model.q(model.spec.default_configuration)))[1][-1])
-        self._epoch: int | None = None
-        self.done = False
-
-    def observe(self, view: RunView) -> None:
-        if view.epoch != self._epoch:  # the run restarted: so does the task
-            self._epoch, self.done = view.epoch, False
-            self.restart(view)
-        if not self.done:
-            self.update(view)
-
-    def restart(self, view: RunView) -> None: ...
-
-    def update(self, view: RunView) -> None: ...
-
-    def progress(self) -> Progress:
-        raise NotImplementedError
-
-
-class Envelope:
-    """max |x| over the last ``window`` s, from samples every observation."""
-
-    def __init__(self, window: float) -> None:
-        self.window = window
-        self.samples: deque[tuple[float, float]] = deque()
-
-    def add(self, t: float, x: float) -> float:
-        self.samples.append((t, abs(x)))
-        while self.samples and self.samples[0][0] < t - self.window:
-            self.samples.popleft()
-        return max(v for _, v in self.samples)
+from rns_viz.live.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
+from rns_viz.live.lessons_boom import BOOM7_LESSONS
 
 
 class KickAndSwing(Check):
@@ -273,25 +208,6 @@ class AbsorbKick(Check):
         return Progress(self.done, f"Swing now {self.ratio:.0%} of its peak.")
 
 
-@dataclass(frozen=True)
-class LessonStart:
-    """The state a lesson loads: a fresh run of ``model`` at rest, the law, suppression, shadow shown."""
-
-    model: str
-    law: LawKind
-    suppress: bool
-
-
-@dataclass(frozen=True)
-class Lesson:
-    title: str
-    equation: str  # the paper's equation(s) it is about
-    text: str  # one or two sentences of explanation
-    task: str  # what the student does
-    start: LessonStart
-    check: Callable[[FsmsModel], Check]
-
-
 TREP_LESSONS = (
     Lesson(
         "The base is a spring",
@@ -382,4 +298,6 @@ PLANAR3R_LESSONS = (
     ),
 )
 
-LESSONS: dict[str, tuple[Lesson, ...]] = {"trep": TREP_LESSONS, "planar3r": PLANAR3R_LESSONS}
+__all__ = ["LESSONS", "Check", "Lesson", "LessonStart", "Progress", "RunView"]
+
+LESSONS: dict[str, tuple[Lesson, ...]] = {"trep": TREP_LESSONS, "planar3r": PLANAR3R_LESSONS, "boom7": BOOM7_LESSONS}

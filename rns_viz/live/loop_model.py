@@ -90,8 +90,9 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) 
     )
     if r < model.m:
         note += (
-            " The other base coordinates are left free: the arm's motion still excites them, and on a "
-            "coupled base (a cantilever couples sideways force and tilt) suppressing the selected modes "
-            "can pump the free ones: watch the base plot; switch suppression off if they grow."
+            " The other base coordinates are left free: the arm's motion still excites them. Suppression "
+            "(15) damps the selected rows of the base momentum, S H_b x_b', which carry the free "
+            "coordinates' share too: on boom7 the free modes then decay as well, at the same gains as with all "
+            "six selected; for another model, check its gain map and watch the base plot."
         )
     return key_of(selected), note

@@ -57,6 +57,7 @@ class Outputs:
         self.last: ControlOutput | None = None
         self.reaction = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1), first selected row
         self.reaction_t = math.nan  # s: the step it was evaluated at (its start time)
+        self.reaction_wrench: tuple[float, ...] = ()  # N, N m: all m base rows of the same reaction
         self._pre: tuple[float, np.ndarray] | None = None  # (t, x = (q, v)) the next evaluated step starts from
         self.ee_error = math.nan  # m
         self.readouts = Readouts()
@@ -92,6 +93,7 @@ class Outputs:
         nv = sim.model.nv
         f = self._probe.force(x[:nv], x[nv:], out.tau, sim.last_force)
         self.reaction, self.reaction_t = float(f[sim.model.selected[0]]), t
+        self.reaction_wrench = tuple(float(x) for x in f)
 
     def _sample_plots(
         self, model: FsmsModel, runs: RunPair, out: ControlOutput, shadow_on: bool, suppress: bool

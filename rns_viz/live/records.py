@@ -63,6 +63,7 @@ class Readouts:
     ee_error: float = math.nan  # m: |x_ref - x_e|
     reaction: float = 0.0  # N: the arm's reaction on the base, -(H_bm theta'' + c_b) of Eq. (1)
     reaction_t: float = math.nan  # s: start time of the step it was evaluated at
+    reaction_wrench: tuple[float, ...] = ()  # N, N m: every base row of the reaction (drawn for a 6-DOF base)
     dual: bool = False  # a task arm and a compensating arm: sigma_hbm is S H_bm,2's, sigma_jbar J_1's
     cancel: str | None = None  # why the compensating arm cannot cancel the reaction now (None: it does)
     compensating: bool = True  # dual arms: the operated run's compensator cancels (the shadow's is held)

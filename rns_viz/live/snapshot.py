@@ -27,7 +27,9 @@ def make_snapshot(
     paused, diverged, rtf, behind = flags
     table = op.table if op is not None and op.on_path else None
     mode, target = (op.mode, op.target) if op is not None else (f"preset {settings.preset}", None)
-    readouts = replace(out.readouts, reaction=out.reaction, reaction_t=out.reaction_t)
+    readouts = replace(
+        out.readouts, reaction=out.reaction, reaction_t=out.reaction_t, reaction_wrench=out.reaction_wrench
+    )
     shadow_on = settings.shadow
     return Snapshot(
         epoch=epoch,

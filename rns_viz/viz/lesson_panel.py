@@ -18,7 +18,7 @@ from rns_viz.live.session import Session
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.view_toggles import ViewToggles
 
-MODEL_SHORT = {"trep": "TREP", "planar3r": "3R"}
+MODEL_SHORT = {"trep": "TREP", "planar3r": "3R", "boom7": "boom7"}
 CHOICES: dict[str, tuple[str, int]] = {
     f"{MODEL_SHORT[model]} {i + 1}. {lesson.title}": (model, i + 1)
     for model, lessons in LESSONS.items()
@@ -37,6 +37,9 @@ LESSON_VIEWS: dict[tuple[str, int], tuple[str, ...]] = {
     ("planar3r", 1): (*BASICS, "coupling", "reach"),
     ("planar3r", 2): (*BASICS, "reach"),
     ("planar3r", 3): (*BASICS, "coupling", "reach", "ghost"),
+    ("boom7", 1): (*BASICS, "ghost"),
+    ("boom7", 2): (*BASICS, "coupling", "null_vector", "path_arrows"),
+    ("boom7", 3): (*BASICS, "coupling"),
 }
 NO_LESSON = (
     "No lesson running. Pick one below and press **Start**, or press **Next** for lesson 1. Each lesson loads "

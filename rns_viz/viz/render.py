@@ -198,7 +198,8 @@ class Renderer:
             with self.server.atomic():
                 self.scene.update(q, exaggeration)
                 f = snap.readouts.reaction  # N, exactly the readout's (Eq. 1); the label shows 3 digits
-                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, self.teach.reaction_label)
+                wrench = snap.readouts.reaction_wrench  # N, N m: all six rows for a 6-DOF base
+                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, self.teach.reaction_label, wrench)
             self.scene_updates += 1
 
     def _draw_target(self, snap: Snapshot) -> None:

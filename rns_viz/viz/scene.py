@@ -20,6 +20,7 @@ from rns_viz.paths import ReactionlessPath
 from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.boom_drawing import BoomDrawing
 from rns_viz.viz.geometry import Trail, path_colours, path_family_segments, polyline_segments
+from rns_viz.viz.reaction_arrows import WrenchArrows
 from rns_viz.viz.robot import RobotMeshes
 from rns_viz.viz.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
 
@@ -117,6 +118,8 @@ class FsmsScene:
         )
         self.force_label = scene.add_label(self.FORCE_LABEL, "", anchor="top-center", visible=False)
         self._force = 0.0
+        # a 6-DOF base: the whole reaction, force and moment (the single arrow above stays hidden)
+        self.wrench = WrenchArrows(server, st, FORCE_COLOUR) if model.m == 6 else None
         self.show_force = self.show_trail = self.show_reach = True  # the view toggles (render thread)
         self._force_axis = model.base_axes()[0] if model.base_is_translational else np.array([1.0, 0.0, 0.0])
         self._force_origin = np.asarray(st.force_origin, dtype=float)
@@ -153,11 +156,15 @@ class FsmsScene:
             if trail and self.trail.push(self._trail_point()):
                 self._draw_trail()
 
-    def set_reaction_force(self, f: float, label: str = "F") -> None:
+    def set_reaction_force(self, f: float, label: str = "F", wrench: Sequence[float] = ()) -> None:
         """Arrow along the base axis at the base: ``f`` in N (the base reaction, paper's F_b).
 
-        The arrow's label reads "<label> = f N".
+        The arrow's label reads "<label> = f N". A 6-DOF base draws ``wrench`` (all six rows of the
+        reaction, N and N m) as a force and a moment arrow instead.
         """
+        if self.wrench is not None:
+            self.wrench.set(wrench, label, self.show_force)
+            return
         if f == self._force and self.force.visible == self.show_force:
             return
         self._force = f

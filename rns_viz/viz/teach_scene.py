@@ -108,7 +108,7 @@ class TeachScene:
         if view.on("reaction") != sc.show_force:
             sc.show_force = view.on("reaction")
             f = snap.readouts.reaction
-            sc.set_reaction_force(f if np.isfinite(f) else 0.0, self.reaction_label)
+            sc.set_reaction_force(f if np.isfinite(f) else 0.0, self.reaction_label, snap.readouts.reaction_wrench)
         if view.on("trail") != sc.show_trail:
             sc.show_trail = view.on("trail")
             sc.trail_node.visible = sc.show_trail and len(sc.trail.points()) >= 2
