@@ -61,7 +61,7 @@ def integrability_note(model: FsmsModel, theta: np.ndarray) -> str:
     )
 
 
-MAX_TRACKING_ROWS = 3  # r <= 3: a 3-D end-effector target is tracked by Eq. (24) in the RNS
+MAX_TRACKING_ROWS = 4  # r <= 4 (n - r >= 3 for n = 7): a 3-D end-effector target is tracked by Eq. (24) in the RNS
 
 
 def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) -> tuple[str, str]:
@@ -76,10 +76,13 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) 
         raise InputRefused("select at least one base reaction to cancel")
     if r >= model.n:
         raise InputRefused(f"with {r} reactions to cancel the {model.n}-joint arm has no reaction null space")
-    if model.n - r != 1 and r > MAX_TRACKING_ROWS:
+    if model.n - r != 1 and (r > MAX_TRACKING_ROWS or model.n - r < len(model.task_rows)):
         raise InputRefused(
-            f"r = {r} leaves a {model.n - r}-D reaction null space that the app does not operate yet: select "
-            f"{model.n - 1} (a 1-D RNS: reactionless paths) or at most {MAX_TRACKING_ROWS} (end-effector tracking)"
+            f"r = {r} leaves a {model.n - r}-D reaction null space: the hand's reactionless motions from here "
+            f"span only a {model.n - r}-D surface, so J-bar (Eq. 24) cannot follow a {len(model.task_rows)}-D "
+            f"target and a dragged point would almost never lie on that surface. Select {model.n - 1} (a 1-D RNS: "
+            f"reactionless paths) or at most {min(MAX_TRACKING_ROWS, model.n - len(model.task_rows))} "
+            "(end-effector tracking)"
         )
     selected = FsmsModel(model.spec.with_selection(flags))
     note = f"r = {r}: the reaction null space has dimension n − r = {model.n - r}. " + (

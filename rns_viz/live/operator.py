@@ -177,7 +177,14 @@ class Operator:
         self.rr.set_goal(clamped)
         self.target = self._point(clamped)
         self.mode = "tracking the target"
+        if moved and not isinstance(self.rr, TaskTarget):
+            self.mode = f"target outside the reactionless-reachable set: held at {self._held_mm():.0f} mm from it"
         return moved
+
+    def _held_mm(self) -> float:
+        """How far (mm) the target in force is from where the operator put it."""
+        k = len(self.model.task_rows)
+        return 1e3 * float(np.linalg.norm(self.target[:k] - self.target_raw[:k]))  # type: ignore[index]
 
     def why_moved(self) -> str:
         """What to tell the operator when :meth:`drag` moved their target."""
@@ -187,7 +194,10 @@ class Operator:
         elif isinstance(self.rr, TaskTarget):
             where = "That target is outside the task arm's workspace"
         else:
-            where = "That target is outside the set reachable without reaction from this configuration"
+            return (
+                "Target outside the reactionless-reachable set from this configuration: held at "
+                f"{self._held_mm():.0f} mm from it, at its nearest reachable point ({point}) m."
+            )
         return f"{where}; it goes to the nearest point ({point}) m instead."
 
     def scrub(self, sigma: float) -> None:
