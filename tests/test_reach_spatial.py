@@ -6,7 +6,7 @@ is refused with the reason.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pinocchio as pin
@@ -17,6 +17,7 @@ from rns_viz.live.reach_spatial import bracket_rank, explore_rns
 from rns_viz.live.readouts import arm_reach
 from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
+from rns_viz.rns import rns_projector
 
 FORCES = (True, True, True, False, False, False)
 
@@ -41,7 +42,7 @@ def test_forces_only_reactionless_motion_keeps_the_centre_of_mass(forces_only: F
     assert np.allclose(m.ee_positions(found.thetas), found.points, atol=1e-12)
 
 
-def _rank(coupling) -> int:  # noqa: ANN001
+def _rank(coupling: Callable[[np.ndarray], np.ndarray]) -> int:
     return bracket_rank(coupling, np.array([0.3, -0.2, 0.5])).with_brackets
 
 
@@ -101,7 +102,7 @@ def test_live_reach_set_inside_tracked_outside_held_and_said(boom: Session) -> N
     region = s.state.operator.reach  # type: ignore[union-attr]
     assert region is not None and region.dims == 3
     start = np.asarray(s.snapshot().target)
-    inside = region.points[np.argmin(np.linalg.norm(region.points - (start + [0.04, -0.03, 0.03]), axis=1))]
+    inside = region.points[np.argmin(np.linalg.norm(region.points - (start + np.array([0.04, -0.03, 0.03])), axis=1))]
     s.set_target(tuple(inside), final=True)
     s.advance(0.01)
     assert not [n for n in s.pop_notices() if n.title == "Target moved"]
@@ -138,12 +139,23 @@ def test_r4_tracks_a_target_and_r5_is_refused_with_the_reason(boom: Session) -> 
     assert s.wait_background(60.0)
     s.advance(0.01)
     start = np.asarray(s.snapshot().target)
-    goal = start + np.array([0.02, 0.01, -0.01])
-    s.set_target(tuple(goal), final=True)
-    s.advance(2.0)
-    model = s.state.model
-    assert np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - s.snapshot().target) < 2e-3
-    assert _reference_coupling(s) <= 1e-9 or np.linalg.norm(s.state.operator.joint.thetadot) == 0.0  # type: ignore[union-attr]
+    model, op = s.state.model, s.state.operator
+    q = model.q(op.rr.theta)  # type: ignore[union-attr]
+    P = rns_projector(model.coupling_matrix(q))
+    data = model.pin_model.createData()
+    J = pin.computeFrameJacobian(model.pin_model, data, q, model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
+    U, sigma, _ = np.linalg.svd(data.oMi[model.base_joint_id].rotation.T @ J[:3, 6:] @ P)
+    assert sigma[-1] > 1e-3  # J-bar is 3 x 7 of rank 3 here: a square task in a 3-D RNS
+    reached = []
+    for sign in (1.0, -1.0):  # 3 cm along J-bar's strongest direction, both ways: at least one is not at a fold
+        goal = s.snapshot().target + sign * 0.03 * U[:, 0]
+        s.set_target(tuple(goal), final=True)
+        s.advance(1.5)
+        gap = np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - goal)
+        reached.append(gap < 3e-3)
+        assert gap < 3e-3 or "singularity of J-bar" in s.snapshot().mode  # reached, or said why not
+        assert _reference_coupling(s) <= 1e-9 or np.linalg.norm(op.joint.thetadot) == 0.0  # type: ignore[union-attr]
+    assert any(reached) and np.linalg.norm(s.snapshot().target - start) < 0.1
     s.set_selection((True, True, True, True, True, False))
     s.advance(0.01)
     refused = [n for n in s.pop_notices() if n.title == "Input not applied"]

@@ -46,6 +46,9 @@ UNCHANGED = OperatorChange()
 SNAP_TOLERANCE_M = 0.005  # m: a dragged target farther than this from the current path is said to be moved
 
 
+BLOCKED = "stopped before a singularity of J-bar (a fold of the reachable set): drag the target elsewhere"
+
+
 class InputRefused(ValueError):
     """An operator input that cannot be applied now; the message says why (shown to that client)."""
 
@@ -260,6 +263,8 @@ class Operator:
                 self.task = TaskSample(rr.x, rr.xdot, rr.xddot)
                 if rr.idle:
                     self.mode = "holding at the target"
+                elif getattr(rr, "blocked", False):
+                    self.mode = BLOCKED
             return UNCHANGED
         if self.joint_move is not None:
             started, self._joint_move_started = self._joint_move_started, False

@@ -14,6 +14,7 @@ another voxel's place is missed.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -154,7 +155,7 @@ class BracketRank:
         )
 
 
-def bracket_rank(coupling, theta: np.ndarray, tol: float = 1e-6) -> BracketRank:  # noqa: ANN001
+def bracket_rank(coupling: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, tol: float = 1e-6) -> BracketRank:
     """Rank of the columns of P_RNS with their pairwise Lie brackets at ``theta`` (central differences).
 
     ``coupling(theta)`` returns S H_bm. Brackets are measured relative to the columns' norms; a
@@ -168,7 +169,7 @@ def bracket_rank(coupling, theta: np.ndarray, tol: float = 1e-6) -> BracketRank:
     out_of: list[np.ndarray] = []
     worst = 0.0
 
-    def column(j: int):  # noqa: ANN202
+    def column(j: int) -> Callable[[np.ndarray], np.ndarray]:
         return lambda th: rns_projector(coupling(th))[:, j]
 
     for i in range(n):
