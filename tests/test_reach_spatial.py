@@ -1,7 +1,7 @@
 """The reactionless-reachable set of boom7 (a base that turns) and the Lie-bracket rank of its RNS
 distribution; live: the set is drawn, a target inside it is tracked without the selected reactions,
-one outside is held at the set's nearest point and the operator is told, r = 4 is operated, r = 5
-is refused with the reason.
+one outside is held at the set's nearest point and the operator is told, r = 4 is operated, and r = 5
+(a 2-D RNS) holds targets on its reachable surface.
 """
 
 from __future__ import annotations
@@ -129,7 +129,7 @@ def test_live_reach_set_inside_tracked_outside_held_and_said(boom: Session) -> N
     assert not snap.diverged and np.all(np.isfinite(snap.q))
 
 
-def test_r4_tracks_a_target_and_r5_is_refused_with_the_reason(boom: Session) -> None:
+def test_r4_tracks_a_target_and_r5_tracks_on_its_reachable_surface(boom: Session) -> None:
     s = boom
     s.set_suppression(False)
     s.set_selection((True, True, True, True, False, False))  # r = 4: a 3-D RNS, J-bar square
@@ -156,8 +156,26 @@ def test_r4_tracks_a_target_and_r5_is_refused_with_the_reason(boom: Session) -> 
         assert gap < 3e-3 or "singularity of J-bar" in s.snapshot().mode  # reached, or said why not
         assert _reference_coupling(s) <= 1e-9 or np.linalg.norm(op.joint.thetadot) == 0.0  # type: ignore[union-attr]
     assert any(reached) and np.linalg.norm(s.snapshot().target - start) < 0.1
-    s.set_selection((True, True, True, True, True, False))
+    s.set_selection((True, True, True, True, True, False))  # r = 5: a 2-D RNS, the reachable set is a surface
     s.advance(0.01)
-    refused = [n for n in s.pop_notices() if n.title == "Input not applied"]
-    assert refused and "r = 5" in refused[0].body and "surface" in refused[0].body
-    assert s.snapshot().settings.model == "boom7#S=111100"
+    told = [n for n in s.pop_notices() if n.title == "Selection S"]
+    assert told and "n − r = 2" in told[0].body and "surface" in told[0].body
+    assert s.wait_background(60.0)
+    s.advance(0.01)
+    region = s.state.operator.reach  # type: ignore[union-attr]
+    assert region is not None and region.surface and len(region.points) > 3
+    start = np.asarray(s.snapshot().target)
+    sample = region.points[np.argsort(np.linalg.norm(region.points - start, axis=1))[1]]  # the nearest other one
+    s.set_target(tuple(sample + np.array([0.0, 0.0, 0.05])), final=True)  # 5 cm off: snapped onto the set
+    s.advance(0.01)
+    assert [n for n in s.pop_notices() if n.title == "Target moved"]
+    held = np.asarray(s.snapshot().target)
+    assert np.min(np.linalg.norm(region.points - held, axis=1)) < 1e-12
+    worst = 0.0
+    for _ in range(30):
+        s.advance(0.1)
+        worst = max(worst, _reference_coupling(s))
+    assert worst <= 1e-9
+    gap = np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - held)
+    assert gap < 3e-3  # m: on the surface (0.12 mm measured after 3 s)
+    assert not s.snapshot().diverged

@@ -27,6 +27,7 @@ class ReachRegion:
     level: np.ndarray  # (r,) coupling potential of the configuration it was explored from, kg m (nan: none)
     dims: int = 2  # the task's coordinates: (x, y) for a planar task, (x, y, z) in space
     note: str = ""  # the Lie-bracket test where it was explored from, in words (empty: not made)
+    surface: bool = False  # fewer RNS directions than task coordinates: the set is a surface, targets snap to it
 
     def distance(self, xy: np.ndarray) -> float:
         """Distance (m) from a target to the nearest sample; within ``radius`` counts as reachable."""
@@ -36,10 +37,12 @@ class ReachRegion:
     def clamp(self, xy: np.ndarray) -> tuple[np.ndarray, bool]:
         """The target itself if reachable, else the reachable point nearest it; and whether it was moved."""
         xy = np.asarray(xy, dtype=float)[: self.dims]
-        if self.distance(xy) <= self.radius:
+        if self.distance(xy) <= (SNAP_M if self.surface else self.radius):
             return xy.copy(), False
         d = self.points[:, : self.dims] - xy
         nearest = self.points[int(np.argmin(np.einsum("ij,ij->i", d, d))), : self.dims]
+        if self.surface:  # a point off a surface is not reachable: its nearest sample, which is
+            return nearest.copy(), True
         lo, hi = 0.0, 1.0  # bisect along nearest -> target for the last point still inside
         for _ in range(20):
             mid = 0.5 * (lo + hi)
@@ -50,6 +53,7 @@ class ReachRegion:
         return nearest + lo * (xy - nearest), True
 
 
+SNAP_M = 1e-3  # m: on a reachable surface, a target this close to a sample is taken as it is
 VOXELS_PER_REACH = 20  # a turning base's set: end-effector voxels of the arm's reach / 20 (5.4 cm for boom7)
 
 
@@ -60,7 +64,8 @@ def build_reach_region(model: FsmsModel, theta: np.ndarray, spacing: float = 0.1
         found = explore_rns(model, theta, voxel)
         rank = bracket_rank(lambda th: model.coupling_matrix(model.q(th)), theta)
         nan = np.full(len(model.selected), np.nan)
-        return ReachRegion(found.points, found.thetas, voxel, nan, len(model.task_rows), rank.words())
+        dims, rns_dim = len(model.task_rows), model.n - len(model.selected)
+        return ReachRegion(found.points, found.thetas, voxel, nan, dims, rank.words(), rns_dim < dims)
     found = reactionless_reachable_set(model, theta, spacing=spacing)
     pts = found.ee
     if len(pts) < 2:
