@@ -112,7 +112,8 @@ def explore_rns(
         cand = _move(model, data, base, v)
         ok = np.all((cand >= lower) & (cand <= upper), axis=1)
         cand = cand[ok]
-        if not len(cand):
+        if not len(cand):  # every move leaves the joint limits: the sweep is complete
+            frontier = cand
             break
         sig = np.linalg.svd(_rows(model, data, cand), compute_uv=False)[:, -1]
         cand = cand[sig > singular_sigma]
