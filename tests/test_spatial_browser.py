@@ -71,3 +71,46 @@ def test_boom7_in_chromium_kick_and_scrub_the_reactionless_path(boom_app: RnsApp
         page.get_by_text("Base coordinates (spatial)", exact=True).scroll_into_view_if_needed()
         wait_for_frames(page, 10)
         assert screenshot(page, "app_boom7_base_panel").stat().st_size > 10_000
+
+
+def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: RnsApp) -> None:
+    """r = 3 (forces only): the reactionless-reachable set is drawn, a real mouse drag on the target
+    handle's x arrow moves the 3-D target, and the arm follows it without force reactions."""
+    from tests.test_dual_browser import drag_handle_along_x
+
+    app, s = boom_app, boom_app.session
+    with browser_page(app.server, width=1400, height=900) as page:
+        wait_for_nodes(page, {FsmsScene.BASE, TARGET_HANDLE, "/boom/tube"}, timeout=60.0)
+        dismiss_notifications(page)
+        s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (README)
+        s.set_selection((True, True, True, False, False, False))  # what ticking off rx, ry, rz sends
+        wait_until(lambda: s.snapshot().settings.model == "boom7#S=111000", 20.0, "the forces-only selection")
+        wait_until(lambda: s.overlays().reach is not None, 60.0, "the reachable set")
+        wait_until(lambda: app.scene.reachable.visible, 20.0, "the reachable set drawn")
+        assert len(s.overlays().reach) > 100 and "involutive" in s.overlays().reach_note  # type: ignore[arg-type]
+        wait_until(lambda: "involutive" in app.base_panel.involution.content, 20.0, "the bracket test in the panel")
+        model = s.state.model
+        hand0 = model.ee_position(s.snapshot().q[6:])
+        before = np.array(s.snapshot().target, dtype=float)
+        wait_for_frames(page, 10)
+        for attempt in range(3):  # a software-rendered page may miss a press made while it re-lays the panel
+            drag_handle_along_x(page, app, 50.0)
+            try:
+                wait_until(lambda: np.linalg.norm(s.snapshot().target - before) > 0.01, 10.0, "the target to move")
+                break
+            except AssertionError:
+                if attempt == 2:
+                    raise
+        wait_until(
+            lambda: np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - hand0) > 0.01, 20.0, "the arm to follow"
+        )
+        wait_until(lambda: not s.state.operator.busy, 30.0, "the arm to arrive")  # type: ignore[union-attr]
+        snap = s.snapshot()
+        assert np.linalg.norm(model.ee_position(snap.q[6:]) - snap.target) < 3e-3
+        L = np.stack([s.state.runs.sim.log.column(f"L_{i}", last=3000) for i in (1, 2, 3)])
+        assert np.abs(L).max() < 1e-2 * model.arm_mass * snap.settings.target_speed  # kg m/s
+        app.scene.set_initial_camera()
+        page.mouse.move(5, 5)
+        dismiss_notifications(page)
+        wait_for_frames(page, 30)
+        assert screenshot(page, "app_boom7_reach").stat().st_size > 10_000

@@ -28,6 +28,7 @@ class Geometry:
     def restart(self) -> None:
         self.current_path: np.ndarray | None = None  # (k, 3) end-effector points of the current path, m
         self.reach_points: np.ndarray | None = None  # (N, 3) reachable end-effector points, m
+        self.reach_note = ""  # the Lie-bracket test where the reachable set was explored from
         self.shown_level: np.ndarray | None = None  # coupling potential of what is shown, kg m
 
     def request(
@@ -40,7 +41,7 @@ class Geometry:
         if model.n - len(model.selected) == 1:
             self.background.path_table(epoch, model.name, theta, default)
             self.background.family(epoch, model.name)
-        elif model.base_is_translational:  # the reachable set is explored on the potential's level set
+        else:  # on the potential's level set (a translating base) or along the distribution (one that turns)
             self.background.reach(epoch, model.name, theta)
 
     def took_table(self, model: str, table: PathTable, default: bool) -> None:
@@ -50,7 +51,9 @@ class Geometry:
 
     def took_reach(self, region: ReachRegion) -> None:
         self.reach_points = region.points
+        self.reach_note = region.note
 
     def overlays(self, model: str) -> Overlays:
         self.version += 1
-        return Overlays(self.background.families.get(model), self.current_path, self.reach_points, self.version)
+        family = self.background.families.get(model)
+        return Overlays(family, self.current_path, self.reach_points, self.version, self.reach_note)

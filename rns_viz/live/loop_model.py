@@ -61,7 +61,14 @@ def integrability_note(model: FsmsModel, theta: np.ndarray) -> str:
     )
 
 
-MAX_TRACKING_ROWS = 3  # r <= 3: a 3-D end-effector target is tracked by Eq. (24) in the RNS
+MAX_TRACKING_ROWS = 5  # r <= 5 (n - r >= 2): a 3-D target is tracked by Eq. (24) in the RNS (on a surface if 2-D)
+
+
+def _surface_note(rns_dim: int) -> str:
+    return (
+        f"With a {rns_dim}-D RNS the hand's reactionless motions span a surface, not a volume: a dragged target "
+        "is held at the nearest point of the drawn reachable set and the hand goes there along the surface. "
+    )
 
 
 def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) -> tuple[str, str]:
@@ -78,7 +85,7 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) 
         raise InputRefused(f"with {r} reactions to cancel the {model.n}-joint arm has no reaction null space")
     if model.n - r != 1 and r > MAX_TRACKING_ROWS:
         raise InputRefused(
-            f"r = {r} leaves a {model.n - r}-D reaction null space that the app does not operate yet: select "
+            f"r = {r} leaves a {model.n - r}-D reaction null space that the app does not operate: select "
             f"{model.n - 1} (a 1-D RNS: reactionless paths) or at most {MAX_TRACKING_ROWS} (end-effector tracking)"
         )
     selected = FsmsModel(model.spec.with_selection(flags))
@@ -86,6 +93,7 @@ def selection_key(model: FsmsModel, flags: tuple[bool, ...], theta: np.ndarray) 
         "The arm moves without reaction along its reactionless path (scrub ū or drag the handle)."
         if model.n - r == 1
         else "Drag the handle: the hand tracks it in 3-D by Eq. (24) without the selected reactions. "
+        + (_surface_note(model.n - r) if model.n - r < len(model.task_rows) else "")
         + integrability_note(selected, theta)
     )
     if r < model.m:

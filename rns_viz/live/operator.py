@@ -46,6 +46,9 @@ UNCHANGED = OperatorChange()
 SNAP_TOLERANCE_M = 0.005  # m: a dragged target farther than this from the current path is said to be moved
 
 
+BLOCKED = "stopped before a singularity of J-bar (a fold of the reachable set): drag the target elsewhere"
+
+
 class InputRefused(ValueError):
     """An operator input that cannot be applied now; the message says why (shown to that client)."""
 
@@ -177,7 +180,14 @@ class Operator:
         self.rr.set_goal(clamped)
         self.target = self._point(clamped)
         self.mode = "tracking the target"
+        if moved and not isinstance(self.rr, TaskTarget):
+            self.mode = f"target outside the reactionless-reachable set: held at {self._held_mm():.0f} mm from it"
         return moved
+
+    def _held_mm(self) -> float:
+        """How far (mm) the target in force is from where the operator put it."""
+        k = len(self.model.task_rows)
+        return 1e3 * float(np.linalg.norm(self.target[:k] - self.target_raw[:k]))  # type: ignore[index]
 
     def why_moved(self) -> str:
         """What to tell the operator when :meth:`drag` moved their target."""
@@ -187,7 +197,10 @@ class Operator:
         elif isinstance(self.rr, TaskTarget):
             where = "That target is outside the task arm's workspace"
         else:
-            where = "That target is outside the set reachable without reaction from this configuration"
+            return (
+                "Target outside the reactionless-reachable set from this configuration: held at "
+                f"{self._held_mm():.0f} mm from it, at its nearest reachable point ({point}) m."
+            )
         return f"{where}; it goes to the nearest point ({point}) m instead."
 
     def scrub(self, sigma: float) -> None:
@@ -250,6 +263,8 @@ class Operator:
                 self.task = TaskSample(rr.x, rr.xdot, rr.xddot)
                 if rr.idle:
                     self.mode = "holding at the target"
+                elif getattr(rr, "blocked", False):
+                    self.mode = BLOCKED
             return UNCHANGED
         if self.joint_move is not None:
             started, self._joint_move_started = self._joint_move_started, False

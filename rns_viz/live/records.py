@@ -139,3 +139,4 @@ class Overlays:
     current: np.ndarray | None  # the current reactionless path's end-effector curve
     reach: np.ndarray | None  # reactionless reachable end-effector points (multi-D RNS)
     version: int
+    reach_note: str = ""  # the Lie-bracket test where the reachable set was explored from, in words

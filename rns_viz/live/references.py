@@ -21,7 +21,7 @@ from rns_viz.live.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic
-from rns_viz.rns import damped_pinv, null_vector, rns_projector
+from rns_viz.rns import DampedInverse, damped_pinv, null_vector, rns_projector
 
 
 class SigmaMotion:
@@ -233,7 +233,19 @@ class ResolvedRate(SmoothedTarget):
         q = np.concatenate([np.zeros(m), theta])
         J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
         J = (data.oMi[self.model.base_joint_id].rotation.T @ J_world)[self.rows]
-        return damped_pinv(J @ self._projector(q), self.threshold, self.threshold).sigma_min
+        return self._inverse(J @ self._projector(q)).sigma_min
+
+    def _inverse(self, J_bar: np.ndarray) -> DampedInverse:
+        """J-bar^+, damped below ``threshold``. With fewer RNS directions than task rows (boom7, r = 5: a 2-D
+        RNS, a 3-D target) J-bar has rank n - r at most: it is inverted on its range (the hand moves toward
+        the target's projection on the reachable surface) and sigma_min is its (n - r)-th singular value."""
+        k = self.model.n - len(self.model.selected)
+        if J_bar.shape[0] <= k:
+            return damped_pinv(J_bar, self.threshold, self.threshold)
+        U, s, Vt = np.linalg.svd(J_bar, full_matrices=False)
+        U, s, Vt = U[:, :k], s[:k], Vt[:k]
+        lam2 = (1.0 - (s[-1] / self.threshold) ** 2) * self.threshold**2 if s[-1] < self.threshold else 0.0
+        return DampedInverse(Vt.T @ np.diag(s / (s**2 + lam2)) @ U.T, float(s[-1]), float(np.sqrt(lam2)))
 
     def ee(self, theta: np.ndarray) -> np.ndarray:
         pm, data, m = self.model.pin_model, self.data, self.model.m
@@ -271,7 +283,7 @@ class ResolvedRate(SmoothedTarget):
             f.v = np.zeros_like(f.v)
             at_goal = False
         P = self._projector(q)
-        inverse = damped_pinv(J @ P, self.threshold, self.threshold)
+        inverse = self._inverse(J @ P)
         self.sigma_jbar = inverse.sigma_min
         thetadot = P @ (inverse.inverse @ (f.v + self.k * (f.x - x)))
         speed = float(np.sqrt(thetadot @ thetadot))

@@ -46,6 +46,7 @@ class BasePanel:
             gui.add_markdown("**Selection S**: tick the base reactions that must vanish (Eq. 8).")
             self.boxes = [gui.add_checkbox(f"S{i + 1}", True) for i in range(BASE_COORDINATES)]
             self.rns = gui.add_markdown("")
+            self.involution = gui.add_markdown("")  # the Lie-bracket test of the RNS distribution (Sec. III-A)
             self.plot = gui.add_uplot(
                 data=tuple(np.zeros(2) for _ in range(BASE_COORDINATES + 1)),
                 series=(
@@ -61,6 +62,7 @@ class BasePanel:
             )
         self.m = 1
         self.plot_version = -1
+        self.overlay_version = -1
         controls.on_input(self.direction, lambda v, c: None)  # read at the next kick
         for box in self.boxes:
             controls.on_input(box, lambda v, c: controls.session.set_selection(self._flags(), c))
@@ -114,8 +116,16 @@ class BasePanel:
         self.rns.content = f"r = {r} of {model.m}; n − r = {n} − {r} = **{n - r}**: {what}."
 
     def update(self, arrays: dict[str, np.ndarray], version: int) -> None:
-        """Send the base coordinates of the operated run (plot buffers in mm / mrad)."""
-        if self.m == 1 or version == self.plot_version or len(arrays["t"]) < 2:
+        """Send the base coordinates of the operated run (plot buffers in mm / mrad), and the integrability
+        of the RNS distribution once a new reachable set arrived."""
+        if self.m == 1:
+            return
+        overlays = self.controls.session.overlays()
+        if overlays.version != self.overlay_version:
+            self.overlay_version = overlays.version
+            text = f"**Reachable set** ({len(overlays.reach)} points drawn). " if overlays.reach is not None else ""
+            self.involution.content = text + overlays.reach_note
+        if version == self.plot_version or len(arrays["t"]) < 2:
             return
         self.plot_version = version
         columns = [np.nan_to_num(arrays[f"xb_{i + 1}"]) for i in range(BASE_COORDINATES)]

@@ -162,6 +162,8 @@ class TeachScene:
     def set_reach(self, points: np.ndarray | None) -> None:
         """The outline of the reactionless-reachable region (base frame points, (N, 3)), or None."""
         self.has_reach = points is not None and len(points) > 2 and bool(np.all(np.isfinite(points)))
+        # a planar region only (the 3R's, at one height): a spatial set (boom7) is drawn as its point cloud alone
+        self.has_reach = self.has_reach and float(np.ptp(np.asarray(points)[:, 2])) < 1e-6
         edge = outline_points(np.asarray(points)) if self.has_reach else np.zeros((0, 3))
         self.has_reach = self.has_reach and len(edge) > 0
         show = self.has_reach and self.scene.show_reach
