@@ -113,6 +113,28 @@ def test_composition_hangs_the_packaged_arm_on_the_mount(tmp_path: Path, monkeyp
     np.testing.assert_allclose(np.diag(M[:3, :3]), link_mass(ASSETS_DIR / "boom7.urdf", "boom_tip") + 3.25, rtol=1e-12)
 
 
+def test_a_parameter_file_extends_boom7_with_a_packaged_arm(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``extends`` takes boom7's tables key by key, ``[model] arm`` composes the URDF (stand-in package)."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    share = stand_in_package(tmp_path / "prefix")
+    monkeypatch.setattr(robots, "share_dir", lambda arm: share)
+    path = tmp_path / "two.toml"
+    path.write_text(
+        f'extends = "{ASSETS_DIR / "boom7.toml"}"\n[model]\nname = "two"\nurdf = "{ASSETS_DIR / "boom7.urdf"}"\n'
+        f'arm = "{PANDA}"\nee_frame = "panda_hand"\ndefault_configuration_deg = [10.0, 20.0]\n'
+        "[arm]\njoint_damping = [0.1, 0.2]\n"
+    )
+    model, boom7 = FsmsModel.from_file(path), FsmsModel.from_name("boom7")
+    assert (model.m, model.n, model.name) == (6, 2, "two") and model.arm_joint_names == ("panda_joint1", "panda_joint2")
+    np.testing.assert_array_equal(model.K_b, boom7.K_b)
+    np.testing.assert_array_equal(model.D_b, boom7.D_b)
+    np.testing.assert_array_equal(model.spec.task_axes, boom7.spec.task_axes)  # not in two.toml: boom7's
+    np.testing.assert_array_equal(model.spec.joint_damping, [0.1, 0.2])
+    path.write_text(path.read_text().replace(PANDA, "example-robot-data/nao"))
+    with pytest.raises(ModelFileError, match="unknown packaged arm"):
+        FsmsModel.from_file(path)
+
+
 def link_mass(urdf: Path, name: str) -> float:
     """The mass of one link of a URDF, kg."""
     link = next(link for link in ET.parse(urdf).getroot().iter("link") if link.get("name") == name)
