@@ -96,11 +96,12 @@ def compose(base_urdf: str, arm_urdf: str, arm: PackagedArm, share: Path) -> str
     mount = next((j for j in base.iter("joint") if j.get("name") == MOUNT_JOINT), None)
     if mount is None or mount.get("type") != "fixed":
         raise ValueError(f"the base URDF has no fixed joint named {MOUNT_JOINT!r} to carry the arm")
-    old_arm = mount.find("child").get("link")
-    for link in _subtree_links(base, old_arm):
-        base.remove(next(e for e in base.findall("link") if e.get("name") == link))
+    old_arm = _link_of(mount, "child")
+    below = set(_subtree_links(base, old_arm))
+    for link in [e for e in base.findall("link") if e.get("name") in below]:
+        base.remove(link)
     for joint in list(base.findall("joint")):
-        if joint is not mount and joint.find("parent").get("link") not in _links(base):
+        if joint is not mount and _link_of(joint, "parent") not in _links(base):
             base.remove(joint)
     mount.find("child").set("link", arm.root_link)
     for element in arm_root:
@@ -122,6 +123,14 @@ def compose(base_urdf: str, arm_urdf: str, arm: PackagedArm, share: Path) -> str
     return ET.tostring(base, encoding="unicode")
 
 
+def _link_of(joint: ET.Element, tag: str) -> str:
+    """The link a joint's <parent> or <child> names; ValueError naming the joint if it has none."""
+    element = joint.find(tag)
+    if element is None or not element.get("link"):
+        raise ValueError(f"<joint name={joint.get('name')!r}> has no <{tag} link=...>")
+    return element.get("link")
+
+
 def _links(robot: ET.Element) -> set[str]:
     return {link.get("name") for link in robot.findall("link")}
 
@@ -130,12 +139,13 @@ def _subtree_links(robot: ET.Element, root: str) -> list[str]:
     """``root`` and every link below it."""
     children: dict[str, list[str]] = {}
     for joint in robot.findall("joint"):
-        children.setdefault(joint.find("parent").get("link"), []).append(joint.find("child").get("link"))
+        children.setdefault(_link_of(joint, "parent"), []).append(_link_of(joint, "child"))
     out, stack = [], [root]
     while stack:
         link = stack.pop()
-        out.append(link)
-        stack.extend(children.get(link, []))
+        if link not in out:  # a malformed file may close a loop
+            out.append(link)
+            stack.extend(children.get(link, []))
     return out
 
 
