@@ -98,6 +98,7 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         target_speed_m_s=0.1,
     ),
 }
+MODEL_DEFAULTS["boom-panda"] = MODEL_DEFAULTS["boom7"]  # the same boom and a Panda of the same kinematics and mass
 GENERIC_DEFAULTS = ModelDefaults(law="acceleration")
 
 

@@ -5,6 +5,8 @@ file holds what a URDF cannot say: which joints are the elastic base coordinates
 stiffness K_b and damping D_b, the selection S of the selective RNS (Sec. III-B), arm joint
 damping D_m, the task axes of the end-effector Jacobian and the default configuration, and for
 arms branching from the base (``[arms]``) which joints form the task arm and the compensating arms.
+A file may take another file's tables as defaults (``extends = "boom7.toml"``, keys of its own win)
+and may name a packaged arm that replaces its URDF's arm (``[model] arm``, see :mod:`rns_viz.robots`).
 
 Units are SI: K_b in N/m (prismatic base coordinate) or N m/rad (revolute), D_b in N s/m or
 N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends in ``_deg``.
@@ -14,15 +16,20 @@ from __future__ import annotations
 
 import math
 import tomllib
+import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from rns_viz.robots import RobotPackageMissing, composed_urdf, is_installed, packaged_arm
+
 ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
-MODEL_NAMES = ("trep", "planar3r", "boom7", "trep2")  # the bundled models the live app serves: one line per model
+MODEL_NAMES = ("trep", "planar3r", "boom7", "trep2", "boom-panda")  # the bundled models the live app serves
 BUNDLED_MODELS = MODEL_NAMES  # every model in assets/, for FsmsModel.from_name
+# Bundled models whose arm comes from an optional package: name -> the packaged arm (rns_viz.robots).
+PACKAGED_MODELS = {"boom-panda": "example-robot-data/panda"}
 SELECTION_MARK = "#S="  # a model key's selection suffix: "boom7#S=111000"
 TASK_AXES = ("x", "y", "z")
 
@@ -130,6 +137,12 @@ def spec_for_key(key: str) -> ModelSpec:
     return replace(spec, name=key)
 
 
+def missing_extra(name: str) -> str | None:
+    """The optional extra a bundled model still needs (``"panda"``), or None when it can load."""
+    arm = PACKAGED_MODELS.get(model_source(name))
+    return None if arm is None or is_installed(arm) else packaged_arm(arm).extra
+
+
 def param_path_for(name: str) -> Path:
     """The parameter file of a bundled model, by name."""
     if name not in BUNDLED_MODELS:
@@ -158,12 +171,19 @@ def _matrix(value: object, shape: tuple[int, int], element: str, path: Path) -> 
 def load_spec(param_path: str | Path) -> ModelSpec:
     """Read and check a parameter file; the URDF path inside is relative to the file."""
     path = Path(param_path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise ModelFileError(f"{path}: cannot read ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelFileError(f"{path}: not valid TOML ({exc})") from None
+    data = _read_toml(path)
+    parent = data.pop("extends", None)
+    if parent is not None:  # the other file's tables are defaults, key by key
+        if not isinstance(parent, str):
+            raise ModelFileError(f"{path}: extends must be a parameter file's name")
+        defaults = _read_toml(path.parent / parent)
+        defaults.pop("extends", None)  # one level: a chain of files would hide where a number comes from
+        for name, table in data.items():
+            if isinstance(table, dict) and isinstance(defaults.get(name), dict):
+                defaults[name] = {**defaults[name], **table}
+            else:
+                defaults[name] = table
+        data = defaults
     model = _get(data, "model", "", path)
     base = _get(data, "base", "", path)
     arm = data.get("arm", {})
@@ -194,9 +214,12 @@ def load_spec(param_path: str | Path) -> ModelSpec:
         raise ModelFileError(f"{path}: [model] urdf must be a file name")
     if not np.all(np.isfinite(theta0_deg)):
         raise ModelFileError(f"{path}: [model] default_configuration_deg must be finite")
+    urdf_path = (path.parent / urdf).resolve()
+    if "arm" in model:
+        urdf_path = _with_packaged_arm(urdf_path, model["arm"], path)
     return ModelSpec(
         name=str(model.get("name", path.stem)),
-        urdf_path=(path.parent / urdf).resolve(),
+        urdf_path=urdf_path,
         param_path=path.resolve(),
         ee_frame=str(_get(model, "ee_frame", "model", path)),
         task_axes=axes,
@@ -206,6 +229,27 @@ def load_spec(param_path: str | Path) -> ModelSpec:
         joint_damping=joint_damping,
         arms=_arm_groups(data.get("arms"), path),
     )
+
+
+def _read_toml(path: Path) -> dict:
+    try:
+        return tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise ModelFileError(f"{path}: cannot read ({exc.strerror})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelFileError(f"{path}: not valid TOML ({exc})") from None
+
+
+def _with_packaged_arm(urdf_path: Path, arm: object, path: Path) -> Path:
+    """[model] arm: the URDF with its arm replaced by a packaged robot's (composed now, cached)."""
+    try:
+        return composed_urdf(urdf_path, str(arm))
+    except KeyError as exc:
+        raise ModelFileError(f"{path}: [model] arm: {exc.args[0]}") from None
+    except RobotPackageMissing as exc:
+        raise ModelFileError(f"{path}: [model] arm = {arm!r}: {exc}") from None
+    except (OSError, ValueError, ET.ParseError) as exc:
+        raise ModelFileError(f"{path}: [model] arm = {arm!r}: cannot compose the URDF ({exc})") from None
 
 
 def _names(value: object, element: str, path: Path) -> tuple[str, ...]:

@@ -7,11 +7,15 @@ pinocchio's ``liMi``. Fixed links (the end effector) have their meshes moved int
 joint's node, so they cost nothing per frame. A pose is only sent when it changed: a planar arm
 sends one orientation per arm joint and one base position per frame. (Each viser pose setter costs
 ~50 us because it runs ``np.allclose``; ``ViserUrdf.update_cfg`` walks yourdfpy's scene graph.)
+A URDF's meshes are read once per file (the robot and its ghost share them; the Panda's .dae meshes
+take a second or two to read); each drawing places copies.
 """
 
 from __future__ import annotations
 
-from functools import partial
+import threading
+from functools import lru_cache, partial
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -21,6 +25,19 @@ import yourdfpy
 
 from rns_viz.model import FsmsModel
 
+_LOADING = threading.Lock()
+
+
+@lru_cache(maxsize=4)
+def _load_urdf(path: Path, mtime_ns: int) -> yourdfpy.URDF:
+    """The URDF with its visual meshes, read once per file version (``mtime_ns``); callers copy meshes."""
+    return yourdfpy.URDF.load(
+        str(path),
+        build_scene_graph=True,
+        load_meshes=True,
+        filename_handler=partial(yourdfpy.filename_handler_magic, dir=path.parent),
+    )
+
 
 class RobotMeshes:
     """One frame node per pinocchio joint, the URDF visuals under the joint that carries them."""
@@ -29,18 +46,22 @@ class RobotMeshes:
         self, server: viser.ViserServer, model: FsmsModel, base_name: str = "/base", root: str = "/robot"
     ) -> None:
         path = model.spec.urdf_path
-        urdf = yourdfpy.URDF.load(
-            str(path),
-            build_scene_graph=True,
-            load_meshes=True,
-            filename_handler=partial(yourdfpy.filename_handler_magic, dir=path.parent),
-        )
         pm = model.pin_model
+        with _LOADING:  # the cached URDF is shared: one reader at a time
+            urdf = _load_urdf(path, path.stat().st_mtime_ns)
+            joint_links = {name: urdf.joint_map[name].child for name in pm.names[1:]}
+            scene = urdf.scene
+            visuals = []  # (link, mesh in its link's frame)
+            for geom_name, mesh in scene.geometry.items():
+                link = scene.graph.transforms.parents[geom_name]
+                local = mesh.copy()
+                local.apply_transform(urdf.get_transform(geom_name, link))
+                visuals.append((link, geom_name, local))
         self.model = model
         self.data = pm.createData()  # own data: the simulation thread may be using model.data
         self.node_names = [root] + [""] * (pm.njoints - 1)
         for j in range(1, pm.njoints):
-            link = urdf.joint_map[pm.names[j]].child
+            link = joint_links[pm.names[j]]
             if j < model.m:
                 self.node_names[j] = f"{root}/{link}"
             elif j == model.m:
@@ -53,12 +74,9 @@ class RobotMeshes:
         self._last: list[tuple[tuple[float, ...], tuple[float, ...]] | None] = [None] * len(self.frames)
         self.meshes: list[viser.SceneNodeHandle] = []
         carrying = {model.m}  # joints whose node carries visuals: the base node (and its children) always
-        scene = urdf.scene
-        for geom_name, mesh in scene.geometry.items():
-            link = scene.graph.transforms.parents[geom_name]
+        for link, geom_name, local in visuals:
             frame = pm.frames[pm.getFrameId(link)]
-            local = mesh.copy()
-            local.apply_transform(frame.placement.homogeneous @ urdf.get_transform(geom_name, link))
+            local.apply_transform(frame.placement.homogeneous)
             node = self.node_names[frame.parentJoint]
             carrying.add(frame.parentJoint)
             self.meshes.append(self._add_mesh(server, f"{node}/{link}_{geom_name}", local))

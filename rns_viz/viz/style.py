@@ -113,7 +113,7 @@ def style_for(model: FsmsModel) -> SceneStyle:
             trail_jump=1.5,
             base_label=(-0.22, 0.1, 0.0),
         )
-    if model_source(model.name) == "boom7":
+    if model_source(model.name) in ("boom7", "boom-panda"):  # the same boom, arm and view
         return SceneStyle(
             base=BoomStyle(),
             camera_position=(5.4, -1.7, 1.25),
