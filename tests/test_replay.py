@@ -19,7 +19,7 @@ from rns_viz.live import commands as c
 from rns_viz.live.recorder import MAX_RECORD_S, read_csv
 from rns_viz.live.replay import replay_snapshot
 from rns_viz.live.session import Session
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.app import RnsApp
 from tests.browser import wait_until
 
 KICKS = {"trep": 0.8, "planar3r": 5.0}
@@ -195,14 +195,6 @@ def test_realtime_loop_waits_during_a_replay_and_goes_on_after() -> None:
         assert s.snapshot().t < t + 2.0  # from where it was, not caught up over the replay's wall time
     finally:
         s.stop()
-
-
-@pytest.fixture
-def trep_app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, realtime=False, verbose=False)
-    assert app.session.wait_background()
-    yield app
-    app.stop()
 
 
 def test_app_draws_the_replayed_step_and_plots(trep_app: RnsApp) -> None:

@@ -7,7 +7,6 @@ CRBA and RNEA, a linear solve, no ABA); the ghost against the shadow simulation'
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import pinocchio as pin
@@ -72,14 +71,6 @@ def test_reaction_readout_is_eq1_at_its_step(model: str, peak: float, motion: st
         assert worst < 1e-9, f"readout differs from Eq. (1) by {worst:.3g} N (largest force {biggest:.3g} N)"
     finally:
         s.stop()
-
-
-@pytest.fixture
-def trep_app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, realtime=False, verbose=False)
-    assert app.session.wait_background()
-    yield app
-    app.stop()
 
 
 def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp) -> None:
