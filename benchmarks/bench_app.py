@@ -124,7 +124,7 @@ def move_target(app: Any, period: float = 2.5) -> None:
     s = app.session
     home = app.model.ee_position(app.model.spec.default_configuration)[:2]
     k = 0
-    while not s._stop:
+    while not s.stopped:
         k += 1
         s.set_target(home + np.array([0.05 * (k % 2), 0.0]), final=True)
         time.sleep(period)

@@ -113,6 +113,11 @@ class Session:
         with self._lock:
             return self.state.outputs.recorder.take(seconds, self.state.model)
 
+    @property
+    def stopped(self) -> bool:
+        """True once :meth:`stop` was called (the loop ends)."""
+        return self._stop
+
     def stop(self) -> None:
         self._stop = True
         self._wake.set()
