@@ -11,7 +11,9 @@ the generated 7-DOF arm of ``benchmarks/oracles.py`` (arm7).
 Each round runs one fresh subprocess per tree, the two alternating (and which goes first alternating
 too), so both see the same machine load; a subprocess warms up, then times ``--steps`` steps of each
 model as one block. Reported: min and median over the rounds of the per-step time, in µs, and the
-ratio this tree / other tree (below 1: this tree is faster).
+ratio this tree / other tree (below 1: this tree is faster); wall-clock time (perf_counter) and the
+process's CPU time (process_time), which a loaded machine inflates less (a waiting process is not
+charged; caches shared with other work still are).
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ MODELS = ("trep", "planar3r", "arm7")
 
 
 def worker(steps: int, arm7_toml: str) -> None:
-    """Time ``steps`` Python steps per model with the rns_viz found on sys.path; print µs/step as JSON."""
+    """Time ``steps`` Python steps per model with the rns_viz found on sys.path; print µs/step (wall, CPU) as JSON."""
     import numpy as np
 
     from rns_viz.control import AccelerationLaw, Gains
@@ -51,15 +53,15 @@ def worker(steps: int, arm7_toml: str) -> None:
         simulator().run(0.3)  # warm-up
         sim = simulator()
         step = sim.step
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         for _ in range(steps):
             step()
-        result[name] = 1e6 * (time.perf_counter() - t0) / steps
+        result[name] = (1e6 * (time.perf_counter() - t0) / steps, 1e6 * (time.process_time() - c0) / steps)
     print(json.dumps(result))
 
 
-def run_worker(tree: Path, steps: int, arm7_toml: Path) -> dict[str, float]:
-    env = {**os.environ, "PYTHONPATH": str(tree)}
+def run_worker(tree: Path, steps: int, arm7_toml: Path) -> dict[str, list[float]]:
+    env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}  # leave the other tree as it is
     command = [sys.executable, str(Path(__file__).resolve()), str(tree), "--worker", str(arm7_toml)]
     done = subprocess.run([*command, "--steps", str(steps)], cwd=tree, env=env, capture_output=True, text=True)
     if done.returncode != 0:
@@ -83,7 +85,8 @@ def main() -> None:
     from benchmarks.oracles import ARM7_TOML, arm7_urdf
 
     trees = {"this": here, "other": args.other.resolve()}
-    times: dict[str, dict[str, list[float]]] = {tree: {name: [] for name in MODELS} for tree in trees}
+    clocks = ("wall", "cpu")
+    times = {(tree, clock): {name: [] for name in MODELS} for tree in trees for clock in clocks}
     load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "arm7.urdf").write_text(arm7_urdf())
@@ -91,20 +94,24 @@ def main() -> None:
         for r in range(args.rounds):
             order = list(trees) if r % 2 == 0 else list(reversed(trees))
             for tree in order:
-                for name, us in run_worker(trees[tree], args.steps, Path(tmp) / "arm7.toml").items():
-                    times[tree][name].append(us)
+                for name, (wall, cpu) in run_worker(trees[tree], args.steps, Path(tmp) / "arm7.toml").items():
+                    times[tree, "wall"][name].append(wall)
+                    times[tree, "cpu"][name].append(cpu)
 
     load = ", ".join(f"{x:.2f}" for x in (*load_before, *os.getloadavg()))
     print(f"Python step (native=False), law (15) g_b=10 g_m=1, RK4 1 ms, {args.steps} steps x {args.rounds} rounds")
     print(f"this: {trees['this']}\nother: {trees['other']}")
     print(f"load average (1, 5, 15 min) before, after: {load}")
-    print(f"{'model':<10}{'this min':>10}{'median':>9}{'other min':>11}{'median':>9}{'ratio min':>11}{'median':>9}")
+    header = ("model", "clock", "this min", "median", "other min", "median", "ratio min", "median")
+    print("{:<10}{:<6}{:>10}{:>9}{:>11}{:>9}{:>11}{:>9}".format(*header))
     for name in MODELS:
-        a, b = times["this"][name], times["other"][name]
-        print(
-            f"{name:<10}{min(a):>10.1f}{statistics.median(a):>9.1f}{min(b):>11.1f}{statistics.median(b):>9.1f}"
-            f"{min(a) / min(b):>11.3f}{statistics.median(a) / statistics.median(b):>9.3f}"
-        )
+        for clock in clocks:
+            a, b = times["this", clock][name], times["other", clock][name]
+            med_a, med_b = statistics.median(a), statistics.median(b)
+            print(
+                f"{name:<10}{clock:<6}{min(a):>10.1f}{med_a:>9.1f}{min(b):>11.1f}{med_b:>9.1f}"
+                f"{min(a) / min(b):>11.3f}{med_a / med_b:>9.3f}"
+            )
     print("µs per step; ratio = this / other (below 1: this tree is faster)")
 
 
