@@ -14,6 +14,9 @@ extension built the law and RK4 run in C++ (rns_viz.sim.native). Baselines:
   with the generated 7-DOF arm). It is also a check: its trajectory must equal the simulator's.
 - "pinocchio calls": crba + nonLinearEffects + 4 x aba alone, the floor of any step built on them.
 
+The Python step against another commit (e.g. issue 9's filing commit, checked out beside this one):
+``python benchmarks/bench_step_vs.py OTHER_CHECKOUT`` (alternating subprocesses, wall and CPU time).
+
 trep2 (TREP with a compensating second arm, Sec. III-B) runs its own law, the CompensatingLaw tracking
 the trep2-circle preset's circle, in Python (no native step for it): its row gives the step with the
 compensator cancelling, with it held (the live shadow run), their sum (what the live app steps per

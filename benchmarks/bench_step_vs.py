@@ -8,10 +8,12 @@ is ``Simulator.step()`` with ``native=False`` (law and RK4 in Python + pinocchio
 on, starting at the model's default configuration with v0 = (0.01, 0, ...), for TREP, the 3R and
 the generated 7-DOF arm of ``benchmarks/oracles.py`` (arm7).
 
-Each round runs one fresh subprocess per tree, the two alternating (and which goes first alternating
-too), so both see the same machine load; a subprocess warms up, then times ``--steps`` steps of each
-model as one block. Reported: min and median over the rounds of the per-step time, in µs, and the
-ratio this tree / other tree (below 1: this tree is faster).
+One subprocess per tree (its own imports), warmed up; the rounds alternate between them (which goes
+first alternating too), so both see the same machine load. A round builds a fresh simulator per model
+and times ``--steps`` steps of it as one block. Reported: min and median over the rounds of the
+per-step time, in µs, and the ratio this tree / other tree (below 1: this tree is faster); wall-clock
+time (perf_counter) and the process's CPU time (process_time), which a loaded machine inflates less
+(a waiting process is not charged; caches shared with other work still are).
 """
 
 from __future__ import annotations
@@ -30,41 +32,71 @@ MODELS = ("trep", "planar3r", "arm7")
 
 
 def worker(steps: int, arm7_toml: str) -> None:
-    """Time ``steps`` Python steps per model with the rns_viz found on sys.path; print µs/step as JSON."""
+    """Serve rounds: for each line on stdin, time ``steps`` Python steps per model with the rns_viz found on
+    sys.path (a fresh simulator each round) and print µs/step (wall, CPU) as one JSON line."""
     import numpy as np
 
     from rns_viz.control import AccelerationLaw, Gains
     from rns_viz.model import FsmsModel
     from rns_viz.sim import Simulator
 
-    result = {}
+    starts = {}
     for name in MODELS:
         model = FsmsModel.from_file(arm7_toml) if name == "arm7" else FsmsModel.from_name(name)
-        q0 = model.q(model.spec.default_configuration)
         v0 = np.zeros(model.nv)
         v0[0] = 0.01
+        starts[name] = (model, model.q(model.spec.default_configuration), v0)
 
-        def simulator(model: FsmsModel = model, q0: np.ndarray = q0, v0: np.ndarray = v0) -> Simulator:
-            law = AccelerationLaw(model, Gains(g_b=10.0, g_m=1.0))
-            return Simulator(model, law, q0=q0, v0=v0, log_capacity=steps + 1, native=False)
+    def simulator(name: str) -> Simulator:
+        model, q0, v0 = starts[name]
+        law = AccelerationLaw(model, Gains(g_b=10.0, g_m=1.0))
+        return Simulator(model, law, q0=q0, v0=v0, log_capacity=steps + 1, native=False)
 
-        simulator().run(0.3)  # warm-up
-        sim = simulator()
-        step = sim.step
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            step()
-        result[name] = 1e6 * (time.perf_counter() - t0) / steps
-    print(json.dumps(result))
+    for name in MODELS:
+        simulator(name).run(0.3)  # warm-up
+    print("ready", flush=True)
+    for _ in sys.stdin:
+        result = {}
+        for name in MODELS:
+            step = simulator(name).step
+            t0, c0 = time.perf_counter(), time.process_time()
+            for _ in range(steps):
+                step()
+            result[name] = (1e6 * (time.perf_counter() - t0) / steps, 1e6 * (time.process_time() - c0) / steps)
+        print(json.dumps(result), flush=True)
 
 
-def run_worker(tree: Path, steps: int, arm7_toml: Path) -> dict[str, float]:
-    env = {**os.environ, "PYTHONPATH": str(tree)}
-    command = [sys.executable, str(Path(__file__).resolve()), str(tree), "--worker", str(arm7_toml)]
-    done = subprocess.run([*command, "--steps", str(steps)], cwd=tree, env=env, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"worker in {tree} failed:\n{done.stderr}")
-    return json.loads(done.stdout.strip().splitlines()[-1])
+class Worker:
+    """A subprocess running :func:`worker` with ``tree`` first on its path; :meth:`round` times one round."""
+
+    def __init__(self, tree: Path, steps: int, arm7_toml: Path) -> None:
+        env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}  # leave the other tree as it is
+        command = [sys.executable, str(Path(__file__).resolve()), str(tree), "--worker", str(arm7_toml)]
+        self.tree = tree
+        self.process = subprocess.Popen(
+            [*command, "--steps", str(steps)],
+            cwd=tree,
+            env=env,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        self._read()  # "ready"
+
+    def _read(self) -> str:
+        line = self.process.stdout.readline()  # type: ignore[union-attr]
+        if not line:
+            raise SystemExit(f"worker in {self.tree} failed (exit {self.process.wait()})")
+        return line
+
+    def round(self) -> dict[str, list[float]]:
+        self.process.stdin.write("go\n")  # type: ignore[union-attr]
+        self.process.stdin.flush()  # type: ignore[union-attr]
+        return json.loads(self._read())
+
+    def close(self) -> None:
+        self.process.stdin.close()  # type: ignore[union-attr]
+        self.process.wait(timeout=30)
 
 
 def main() -> None:
@@ -83,28 +115,36 @@ def main() -> None:
     from benchmarks.oracles import ARM7_TOML, arm7_urdf
 
     trees = {"this": here, "other": args.other.resolve()}
-    times: dict[str, dict[str, list[float]]] = {tree: {name: [] for name in MODELS} for tree in trees}
+    clocks = ("wall", "cpu")
+    times = {(tree, clock): {name: [] for name in MODELS} for tree in trees for clock in clocks}
     load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "arm7.urdf").write_text(arm7_urdf())
         (Path(tmp) / "arm7.toml").write_text(ARM7_TOML)
+        workers = {tree: Worker(path, args.steps, Path(tmp) / "arm7.toml") for tree, path in trees.items()}
         for r in range(args.rounds):
             order = list(trees) if r % 2 == 0 else list(reversed(trees))
             for tree in order:
-                for name, us in run_worker(trees[tree], args.steps, Path(tmp) / "arm7.toml").items():
-                    times[tree][name].append(us)
+                for name, (wall, cpu) in workers[tree].round().items():
+                    times[tree, "wall"][name].append(wall)
+                    times[tree, "cpu"][name].append(cpu)
+        for w in workers.values():
+            w.close()
 
     load = ", ".join(f"{x:.2f}" for x in (*load_before, *os.getloadavg()))
     print(f"Python step (native=False), law (15) g_b=10 g_m=1, RK4 1 ms, {args.steps} steps x {args.rounds} rounds")
     print(f"this: {trees['this']}\nother: {trees['other']}")
     print(f"load average (1, 5, 15 min) before, after: {load}")
-    print(f"{'model':<10}{'this min':>10}{'median':>9}{'other min':>11}{'median':>9}{'ratio min':>11}{'median':>9}")
+    header = ("model", "clock", "this min", "median", "other min", "median", "ratio min", "median")
+    print("{:<10}{:<6}{:>10}{:>9}{:>11}{:>9}{:>11}{:>9}".format(*header))
     for name in MODELS:
-        a, b = times["this"][name], times["other"][name]
-        print(
-            f"{name:<10}{min(a):>10.1f}{statistics.median(a):>9.1f}{min(b):>11.1f}{statistics.median(b):>9.1f}"
-            f"{min(a) / min(b):>11.3f}{statistics.median(a) / statistics.median(b):>9.3f}"
-        )
+        for clock in clocks:
+            a, b = times["this", clock][name], times["other", clock][name]
+            med_a, med_b = statistics.median(a), statistics.median(b)
+            print(
+                f"{name:<10}{clock:<6}{min(a):>10.1f}{med_a:>9.1f}{min(b):>11.1f}{med_b:>9.1f}"
+                f"{min(a) / min(b):>11.3f}{med_a / med_b:>9.3f}"
+            )
     print("µs per step; ratio = this / other (below 1: this tree is faster)")
 
 

@@ -91,6 +91,34 @@ def test_coupling_blocks_match_the_mass_matrix(planar3r: FsmsModel) -> None:
     np.testing.assert_allclose(cp.project(v[1:]), cp.P @ v[1:], atol=1e-15)
 
 
+def test_one_row_coupling_numbers_are_the_mass_matrix_and_state(planar3r: FsmsModel) -> None:
+    """The floats the one-row branches read (Coupling.row) are the numpy blocks the other laws read."""
+    law = AccelerationLaw(planar3r, Gains())
+    q = planar3r.q(planar3r.spec.default_configuration + 0.2, [0.01])
+    v = np.array([0.1, 0.2, -0.3, 0.4])
+    cp = law.coupling(q, v)
+    M, _, hbm_dot = planar3r.dynamics(q, v)
+    row = cp.row
+    assert row is not None
+    np.testing.assert_array_equal(row.M_rows, M)
+    np.testing.assert_array_equal(row.h, M[0, 1:])
+    np.testing.assert_array_equal(row.thetadot, cp.thetadot)
+    assert (row.H_b, row.xdot_b, row.hbm_dot_thetadot) == (M[0, 0], v[0], hbm_dot[0])
+    np.testing.assert_allclose(cp.coupling_momentum, M[:1, 1:] @ v[1:], rtol=1e-15)
+    np.testing.assert_allclose(row.L, cp.coupling_momentum[0], rtol=1e-15)
+    assert cp.sigma == pytest.approx(np.linalg.norm(M[0, 1:]), rel=1e-15)
+
+
+def test_default_null_input_follows_its_gain() -> None:
+    """The default null input's output is built once per g_m: a new g_m (retune or set) is used at once."""
+    damp = DampNullMotion(2.0)
+    assert damp(0.0, None, None, None).damping == 2.0  # type: ignore[arg-type]
+    damp.retune(Gains(g_m=5.0))
+    assert damp(0.0, None, None, None).damping == 5.0  # type: ignore[arg-type]
+    damp.g_m = 7.0
+    assert damp(0.0, None, None, None).damping == 7.0  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("capacity", [50, 1000])
 def test_logged_end_effector_is_forward_kinematics(trep: FsmsModel, capacity: int) -> None:
     """ee columns are filled when the log is read; reads mid-run and ring wrap-around included."""
