@@ -13,9 +13,7 @@ The real-time factor at 1 kHz is 1000 us / step; a live dual-arm view with its s
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -23,19 +21,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from benchmarks.step_timing import interleaved, load_line, step_round
 from rns_viz.control import AccelerationLaw, Gains
 from rns_viz.model import FsmsModel
 from rns_viz.scenarios import trep2_circle
 from rns_viz.sim import Simulator
-
-
-def step_round(sim: Simulator, q0: np.ndarray, steps: int) -> float:
-    """Microseconds per step over one round of ``steps`` steps from q0 (t = 0.5 s: the circle is moving)."""
-    sim.reset(q0, t0=0.5)
-    start = time.perf_counter()
-    for _ in range(steps):
-        sim.step()
-    return (time.perf_counter() - start) / steps * 1e6
 
 
 def main() -> None:
@@ -49,7 +39,7 @@ def main() -> None:
         sim = trep2_circle(compensate)
         q0 = sim.q.copy()
         label = f"trep2 (5 DOF), {'compensating' if compensate else 'held'}, Python"
-        cases[label] = lambda sim=sim, q0=q0: step_round(sim, q0, args.steps)
+        cases[label] = lambda sim=sim, q0=q0: step_round(sim, q0, args.steps, t0=0.5)  # the circle is moving
     trep = FsmsModel.from_name("trep")
     q_trep = trep.q(trep.spec.default_configuration, np.array([2e-3]))
     for native in (False, True):
@@ -61,14 +51,8 @@ def main() -> None:
             sim, q_trep, args.steps
         )
 
-    samples: dict[str, list[float]] = {name: [] for name in cases}
-    for run in cases.values():  # warm-up
-        run()
-    for _ in range(args.rounds):
-        for name, run in cases.items():
-            samples[name].append(run())
-    medians = {name: statistics.median(values) for name, values in samples.items()}
-    print(f"closed-loop step, RK4 1 ms (median of {args.rounds} rounds x {args.steps} steps)")
+    medians = interleaved(cases, args.rounds)
+    print(f"closed-loop step, RK4 1 ms (median of {args.rounds} rounds x {args.steps} steps; {load_line()})")
     for label, us in medians.items():
         print(f"  {label:<42} {us:8.1f} us   real-time factor at 1 kHz {1e3 / us:5.2f}")
     dual = medians["trep2 (5 DOF), compensating, Python"]

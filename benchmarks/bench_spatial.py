@@ -15,7 +15,6 @@ Run on demand:  python benchmarks/bench_spatial.py [--steps 300] [--rounds 15] [
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
 import time
 from collections.abc import Callable
@@ -25,6 +24,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from benchmarks.step_timing import interleaved, load_line, step_round
 from rns_viz.control import AccelerationLaw, Gains
 from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family
@@ -39,29 +39,10 @@ def initial_state(model: FsmsModel) -> np.ndarray:
     return model.q(model.spec.default_configuration, X_B0[model.name])
 
 
-def step_round(sim: Simulator, steps: int) -> float:
-    """Microseconds per step over one round of ``steps`` steps, restarting from the deflected base."""
-    sim.reset(initial_state(sim.model))
-    start = time.perf_counter()
-    for _ in range(steps):
-        sim.step()
-    return (time.perf_counter() - start) / steps * 1e6
-
-
 def family_ms(model: FsmsModel) -> float:
     start = time.perf_counter()
     path_family(model, 40)
     return (time.perf_counter() - start) * 1e3
-
-
-def interleaved(cases: dict[str, Callable[[], float]], rounds: int) -> dict[str, float]:
-    samples: dict[str, list[float]] = {name: [] for name in cases}
-    for run in cases.values():  # warm-up
-        run()
-    for _ in range(rounds):
-        for name, run in cases.items():
-            samples[name].append(run())
-    return {name: statistics.median(values) for name, values in samples.items()}
 
 
 def main() -> None:
@@ -81,9 +62,11 @@ def main() -> None:
                 print(f"{name}: native step not built or not covering this model; Python only")
                 continue
             label = f"{name} ({model.nv} DOF), {'C++' if native else 'Python'} step"
-            step_cases[label] = lambda sim=sim: step_round(sim, args.steps)
+            q0 = initial_state(model)
+            step_cases[label] = lambda sim=sim, q0=q0: step_round(sim, q0, args.steps)
     steps = interleaved(step_cases, args.rounds)
-    print(f"\nclosed-loop step, law (15), RK4 1 ms (median of {args.rounds} rounds x {args.steps} steps)")
+    rounds = f"median of {args.rounds} rounds x {args.steps} steps"
+    print(f"\nclosed-loop step, law (15), RK4 1 ms ({rounds}; {load_line()})")
     for label, us in steps.items():
         print(f"  {label:<34} {us:8.1f} us   real-time factor at 1 kHz {1e3 / us:5.2f}")
     trep_py = steps["trep (3 DOF), Python step"]
@@ -91,7 +74,7 @@ def main() -> None:
     print(f"  ratio boom7 / TREP (Python): {boom_py / trep_py:.2f}")
 
     families = interleaved({name: lambda m=m: family_ms(m) for name, m in models.items()}, args.family_rounds)
-    print(f"\npath family of 40 curves (median of {args.family_rounds} rounds)")
+    print(f"\npath family of 40 curves (median of {args.family_rounds} rounds; {load_line()})")
     for name, ms in families.items():
         print(f"  {name:<8} {ms:8.1f} ms")
     verdict = "meets" if families["boom7"] <= FAMILY_TARGET_MS else "misses"

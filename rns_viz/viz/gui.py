@@ -81,8 +81,6 @@ class GuiElements:
     speed: viser.GuiDropdownHandle
     readouts: viser.GuiHtmlHandle
     plots: LivePlots
-    plot_xb: viser.GuiUplotHandle  # the linear charts of ``plots``
-    plot_L: viser.GuiUplotHandle
     plot_error: viser.GuiUplotHandle
     path_folder: viser.GuiFolderHandle
     sigma: viser.GuiSliderHandle
@@ -106,6 +104,15 @@ class GuiElements:
     exaggeration: viser.GuiSliderHandle
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
+
+    @property
+    def plot_xb(self) -> viser.GuiUplotHandle:
+        """The linear x_b chart shown now (its legend names the served model's two runs)."""
+        return self.plots.xb
+
+    @property
+    def plot_L(self) -> viser.GuiUplotHandle:
+        return self.plots.L
 
 
 def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = None) -> GuiElements:
@@ -281,8 +288,6 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         speed=speed,
         readouts=readouts,
         plots=plots,
-        plot_xb=plots.xb,
-        plot_L=plots.L,
         plot_error=plots.error,
         path_folder=path_folder,
         sigma=sigma,

@@ -107,11 +107,14 @@ class RankInsetPanel:
         self._plane: tuple[str, float | None] | None = None  # the plane of ``picture``
         self._drawing: tuple[str, float | None] | None = None  # the plane being drawn in the background
         self._lock = threading.Lock()
+        self._model: tuple[str, FsmsModel] | None = None
 
     def refresh(self, snap: Snapshot) -> None:
         key = snap.settings.model
         on = self.view.on("rank") and "rank" in self.view.boxes
-        model = FsmsModel.from_key(key) if on else None
+        if on and (self._model is None or self._model[0] != key):
+            self._model = (key, FsmsModel.from_key(key))  # loaded once per model, not every refresh
+        model = self._model[1] if on and self._model is not None else None
         theta = None if model is None else np.asarray(snap.q[model.m :], dtype=float)
         drawable = model is not None and has_rank_inset(model) and theta is not None and np.all(np.isfinite(theta))
         if not drawable:
