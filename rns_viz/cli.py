@@ -21,7 +21,9 @@ from rns_viz.params import MODEL_NAMES, ModelFileError, model_key
 if TYPE_CHECKING:
     from rns_viz.model import FsmsModel
 
-MODEL_HELP = "trep, planar3r, boom7 (bundled), or a model's parameter file (.toml)"
+MODEL_HELP = (
+    "trep, trep2, planar3r, boom7 (bundled), boom-panda (with rns-viz[panda]), or a model's parameter file (.toml)"
+)
 
 
 class CliError(Exception):
@@ -239,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Reaction null-space control of a flexible-structure-mounted manipulator "
         "(Nenchev et al. 1999). Without a command, starts the browser app.",
     )
-    lesson_help = "start the app at lesson N of the model (TREP: 1-6, planar3r: 1-3)"
+    lesson_help = "start the app at lesson N of the model (TREP: 1-6, planar3r: 1-3, boom7: 1-3)"
     parser.add_argument("--lesson", dest="top_lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
     sub = parser.add_subparsers(dest="command")
     info = sub.add_parser("info", help="print a model's dimensions and base parameters as JSON")
