@@ -3,9 +3,9 @@ same ideas on the spatial model boom7 (m = 6, n = 7; Secs. II-V in general form)
 redundancy on trep2 (Sec. III-B: a compensating second arm).
 
 Each preset builds a ready :class:`Simulator` with the paper's parameters. Choices the paper
-leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS,
-apart from SCENARIOS, until the live app serves that model; trep2's are in DUAL_SCENARIOS, which the live
-app offers beside SCENARIOS (LIVE_SCENARIOS);
+leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS and the
+same experiments with the Franka Panda on that boom (boom-panda) in PANDA_SCENARIOS; trep2's are in
+DUAL_SCENARIOS; the live app offers all of them (LIVE_SCENARIOS);
 ``run_scenario`` runs all of them.
 """
 
@@ -191,14 +191,17 @@ BOOM7_DISPLACEMENT = np.array([0.08, 0.06, 0.06])
 FORCES_ONLY = (1, 1, 1, 0, 0, 0)  # S: reactions x, y, z must vanish; moments rx, ry, rz are free
 
 
-def _boom7(selection: tuple[int, ...] | None = None) -> FsmsModel:
-    model = FsmsModel.from_name("boom7")
+BOOMS = ("boom7", "boom-panda")  # the same boom, kinematics, limits and theta_0; the arms' inertias differ
+
+
+def _boom(name: str, selection: tuple[int, ...] | None = None) -> FsmsModel:
+    model = FsmsModel.from_name(name)
     return model if selection is None else model.with_selection(selection)
 
 
-def boom7_kick(suppress: bool) -> Simulator:
+def boom7_kick(suppress: bool, name: str = "boom7") -> Simulator:
     """Kick in all six directions; (15) suppresses all six modes (S = E), or the joints are held."""
-    model = _boom7()
+    model = _boom(name)
     theta0 = model.spec.default_configuration
     held = JointServo(model, BOOM7_GAINS, FixedReference(theta0))
     law = AccelerationLaw(model, BOOM7_GAINS) if suppress else held
@@ -212,17 +215,17 @@ def boom7_path_reference(model: FsmsModel) -> PathReference:
     return PathReference(model, theta0, QuinticUbar(sigma, BOOM7_MOVE_S, start=BOOM7_START_S))
 
 
-def boom7_path() -> Simulator:
+def boom7_path(name: str = "boom7") -> Simulator:
     """r = 6: law (15) tracking the reactionless path in the 1-D RNS (P_RNS u, Eq. 15)."""
-    model = _boom7()
+    model = _boom(name)
     reference = TrackJointReference(boom7_path_reference(model), BOOM7_GAINS.k_p, BOOM7_GAINS.k_d)
     law = AccelerationLaw(model, BOOM7_GAINS, null_input=reference)
     return Simulator(model, law)
 
 
-def boom7_track() -> Simulator:
+def boom7_track(name: str = "boom7") -> Simulator:
     """r = 3: reactionless end-effector tracking with forces only, Eq. (24), moments left free."""
-    model = _boom7(FORCES_ONLY)
+    model = _boom(name, FORCES_ONLY)
     start = model.ee_position(model.spec.default_configuration)
     task = TaskQuintic(start, start + BOOM7_DISPLACEMENT, BOOM7_MOVE_S, t0=BOOM7_START_S)
     law = AccelerationLaw(
@@ -232,37 +235,39 @@ def boom7_track() -> Simulator:
 
 
 @cache
-def boom7_track_end() -> tuple[float, ...]:
+def boom7_track_end(name: str = "boom7") -> tuple[float, ...]:
     """Joint angles (rad) where forces-only tracking ends: the point-to-point motion's end point."""
-    sim = boom7_track()
+    sim = boom7_track(name)
     sim.run(BOOM7_START_S + BOOM7_MOVE_S + 0.3)
     return tuple(sim.q[sim.model.m :])
 
 
-def boom7_point_to_point(selection: tuple[int, ...] = FORCES_ONLY) -> Simulator:
+def boom7_point_to_point(selection: tuple[int, ...] = FORCES_ONLY, name: str = "boom7") -> Simulator:
     """The same end points as the tracking, by a joint-space quintic of the same duration."""
-    model = _boom7(selection)
+    model = _boom(name, selection)
     theta0 = model.spec.default_configuration
-    quintic = JointQuintic(theta0, np.array(boom7_track_end()), BOOM7_MOVE_S, t0=BOOM7_START_S)
+    quintic = JointQuintic(theta0, np.array(boom7_track_end(name)), BOOM7_MOVE_S, t0=BOOM7_START_S)
     return Simulator(model, JointServo(model, BOOM7_GAINS, quintic))
 
 
-SPATIAL_SCENARIOS: dict[str, Scenario] = {
-    s.name: s
-    for s in (
-        Scenario(
-            "boom7-kick-on",
-            "boom7",
-            5.0,
-            "boom7: kick in 6 directions, (15) suppresses all six modes",
-            lambda: boom7_kick(True),
-        ),
-        Scenario("boom7-kick-off", "boom7", 5.0, "boom7: kick in 6 directions, joints held", lambda: boom7_kick(False)),
-        Scenario("boom7-path", "boom7", 3.0, "boom7: reactionless path with r = 6 (1-D RNS), law (15)", boom7_path),
-        Scenario("boom7-track", "boom7", 3.0, "boom7: end-effector tracking (24), forces only (r = 3)", boom7_track),
-        Scenario("boom7-p2p", "boom7", 3.0, "boom7: same end points, joint-space quintic", boom7_point_to_point),
+def boom_scenarios(name: str) -> dict[str, Scenario]:
+    """The boom's five presets for one of BOOMS, named after it (boom7-path, boom-panda-path, ...)."""
+    presets = (
+        ("kick-on", 5.0, "kick in 6 directions, (15) suppresses all six modes", lambda: boom7_kick(True, name)),
+        ("kick-off", 5.0, "kick in 6 directions, joints held", lambda: boom7_kick(False, name)),
+        ("path", 3.0, "reactionless path with r = 6 (1-D RNS), law (15)", lambda: boom7_path(name)),
+        ("track", 3.0, "end-effector tracking (24), forces only (r = 3)", lambda: boom7_track(name)),
+        ("p2p", 3.0, "same end points, joint-space quintic", lambda: boom7_point_to_point(name=name)),
     )
-}
+    return {
+        f"{name}-{key}": Scenario(f"{name}-{key}", name, duration, f"{name}: {what}", build)
+        for key, duration, what, build in presets
+    }
+
+
+SPATIAL_SCENARIOS: dict[str, Scenario] = boom_scenarios("boom7")
+# The Panda's presets: boom7's experiments with the package's arm (needs rns-viz[panda] to build).
+PANDA_SCENARIOS: dict[str, Scenario] = boom_scenarios("boom-panda")
 
 # -- trep2: TREP with a compensating second arm (assets/trep2.toml) --------------------------------
 # The task arm draws one circle of 40 mm radius, its angle quintic over 4 s from 0.2 s, starting at
@@ -308,8 +313,8 @@ DUAL_SCENARIOS: dict[str, Scenario] = {
         ),
     )
 }
-ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}
-LIVE_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}  # the app's presets
+ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **PANDA_SCENARIOS, **DUAL_SCENARIOS}
+LIVE_SCENARIOS: dict[str, Scenario] = dict(ALL_SCENARIOS)  # the app's presets
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:

@@ -29,6 +29,7 @@ from rns_viz.scenarios import (
     BOOM7_START_S,
     DUAL_SCENARIOS,
     SCENARIOS,
+    PANDA_SCENARIOS,
     SPATIAL_SCENARIOS,
     boom7_path_reference,
     boom7_track,
@@ -227,10 +228,10 @@ def test_mujoco_replay_of_the_3d_kick_reproduces_all_six_deflections(boom7: Fsms
 
 
 def test_spatial_presets_are_apart_from_the_apps(boom7: FsmsModel) -> None:
-    """The app (SCENARIOS) cannot serve boom7 yet; run_scenario and the CLI take ALL_SCENARIOS."""
+    """boom7's presets, named apart from the paper's; run_scenario and the CLI take ALL_SCENARIOS."""
     assert set(SPATIAL_SCENARIOS) == {"boom7-kick-on", "boom7-kick-off", "boom7-path", "boom7-track", "boom7-p2p"}
     assert not set(SPATIAL_SCENARIOS) & set(SCENARIOS)
-    assert ALL_SCENARIOS == {**SCENARIOS, **SPATIAL_SCENARIOS, **DUAL_SCENARIOS}
+    assert ALL_SCENARIOS == {**SCENARIOS, **SPATIAL_SCENARIOS, **PANDA_SCENARIOS, **DUAL_SCENARIOS}
     assert all(s.model == "boom7" for s in SPATIAL_SCENARIOS.values())
     gains = defaults_for("boom7").gains_for("acceleration")  # what the app will start with
     assert (gains.g_b, gains.g_m) == (BOOM7_GAINS.g_b, BOOM7_GAINS.g_m)

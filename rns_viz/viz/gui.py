@@ -17,7 +17,8 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.laws import LAW_LABELS
 from rns_viz.live.pacing import SPEEDS
-from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS
+from rns_viz.params import model_source
+from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, PANDA_SCENARIOS
 from rns_viz.viz.live_plots import LivePlots
 from rns_viz.viz.model_menu import ModelMenu
 
@@ -25,6 +26,7 @@ SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
 PLANAR3R_PRESETS = ("fig3", "fig4")
 BOOM7_PRESETS = ("boom7-kick-on", "boom7-kick-off", "boom7-path", "boom7-track", "boom7-p2p")
+PANDA_PRESETS = tuple(PANDA_SCENARIOS)  # the same five on the Panda; shown instead while boom-panda is served
 DUAL_PRESETS = tuple(DUAL_SCENARIOS)  # trep2: the task arm's circle and a kick, compensator on and off
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
@@ -97,6 +99,7 @@ class GuiElements:
     presets_3r: viser.GuiButtonGroupHandle
     presets_dual: viser.GuiButtonGroupHandle
     presets_boom7: viser.GuiButtonGroupHandle
+    presets_panda: viser.GuiButtonGroupHandle
     preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
@@ -162,6 +165,9 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=preset_hint(PLANAR3R_PRESETS))
         presets_dual = gui.add_button_group("TREP + compensator", DUAL_PRESETS, hint=preset_hint(DUAL_PRESETS))
         presets_boom7 = gui.add_button_group("Boom (3-D)", BOOM7_PRESETS, hint=preset_hint(BOOM7_PRESETS))
+        presets_panda = gui.add_button_group(
+            "Panda on the boom", PANDA_PRESETS, hint=preset_hint(PANDA_PRESETS), visible=False
+        )
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
@@ -304,6 +310,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         presets_3r=presets_3r,
         presets_dual=presets_dual,
         presets_boom7=presets_boom7,
+        presets_panda=presets_panda,
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
@@ -319,6 +326,12 @@ def preset_hint(names: tuple[str, ...]) -> str:
     what = "; ".join(f"{name}: {LIVE_SCENARIOS[name].description.split(': ', 1)[-1]}" for name in names)
     units = "Gains in 1/s, u-bar in 1/(kg m s)."
     return f"One click loads a figure's experiment (law, gains, motion, kicks, model). {what}. {units}"
+
+
+def show_boom_presets(g: GuiElements, model_key: str) -> None:
+    """The boom's presets for the arm in view: the Panda's while boom-panda is served, else boom7's."""
+    panda = model_source(model_key) == "boom-panda"
+    g.presets_panda.visible, g.presets_boom7.visible = panda, not panda
 
 
 def preset_description(name: str | None) -> str:

@@ -26,7 +26,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.viz.base_panel import BasePanel
 from rns_viz.viz.connections import Connections
 from rns_viz.viz.gain_panel import GainExplorerView
-from rns_viz.viz.gui import SPEED_LABELS, GuiElements, preset_description
+from rns_viz.viz.gui import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
 from rns_viz.viz.panel_text import readouts_html, status_html
@@ -109,6 +109,7 @@ class Renderer:
         self.controls.target_lift = np.array([0.0, 0.0, st.overlay_z])
         if self.base_panel is not None:
             self.base_panel.for_model(self.model)
+        show_boom_presets(self.gui, snap.settings.model)
         self.server.scene.add_label(
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
