@@ -77,7 +77,7 @@ class Outputs:
             self._evaluate_reaction(runs, out)
         if (self.steps + 1) % REACTION_EVERY == 0:  # the next step is evaluated: keep its start state
             self._pre = (sim.t, np.concatenate((sim.q, sim.v)))
-        self.recorder.append(runs, shadow_on, self.reaction, suppress)
+        self.recorder.append(runs, shadow_on, self.reaction_wrench, suppress)
         if self.steps % PLOT_EVERY == 0:
             self._sample_plots(model, runs, out, shadow_on, suppress)
         if self.steps % READOUT_EVERY == 0:

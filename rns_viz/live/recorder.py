@@ -5,7 +5,8 @@
 preallocated ring buffer: per step, the operated run's step-log row (t, x_b, x_b', θ, θ', τ, the
 base force, L, the distances to singularity and the law's references θ_ref / x_ref, exactly the
 floats of the simulation log), the shadow run's state, L and τ at the same t, the arm's reaction on
-the base (Eq. 1) as the readout showed it and whether suppression was on. Always on because it costs
+the base (Eq. 1) as the readout showed it (every base row: the wrench a 6-DOF base draws as arrows)
+and whether suppression was on. Always on because it costs
 one row copy per step (about 2 µs: 0.2 % of one core) and 60 s of TREP fill 15 MB (3R: 18 MB);
 it restarts with the run (reset, model switch, preset load), so a recording never spans two systems.
 
@@ -31,7 +32,15 @@ from rns_viz.sim.log import write_csv_rows
 MAX_RECORD_S = 60.0  # s of simulated time kept
 PLOT_WINDOW_S = 10.0  # s: the live plots' window, replayed alike
 PLOT_EVERY = 20  # steps between replayed plot samples (50 Hz, as live)
-EXTRA = ("reaction", "suppress")  # N: the readout's reaction; 1.0 while the operated run had suppression on
+SUPPRESS = "suppress"  # 1.0 while the operated run had suppression on
+
+
+def reaction_columns(m: int) -> tuple[str, ...]:
+    """The reaction's columns, Eq. (1)'s −(H_bm θ'' + c_b): ``reaction`` (N) for a 1-DOF base, else one
+    per base row, ``reaction_1 .. reaction_m`` (N along a translation, N m about a rotation)."""
+    return ("reaction",) if m == 1 else tuple(f"reaction_{i + 1}" for i in range(m))
+
+
 _UNITS = {
     "t": "s",
     "xbdot": "m/s",
@@ -56,8 +65,8 @@ def column_unit(name: str, rotational_base: bool = False) -> str:
     name = name.removeprefix("shadow_")
     for prefix, unit in _UNITS.items():  # longest prefixes first where they share a start
         if name == prefix or name.startswith(prefix + "_"):
-            if rotational_base and prefix in ("xb", "xbdot", "fext"):
-                return {"xb": "rad", "xbdot": "rad/s", "fext": "N m"}[prefix]
+            if rotational_base and prefix in ("xb", "xbdot", "fext", "reaction"):
+                return {"xb": "rad", "xbdot": "rad/s", "fext": "N m", "reaction": "N m"}[prefix]
             return unit
     return ""
 
@@ -199,8 +208,23 @@ class Recording:
 
     # ---------------------------------------------------------------- CSV
     def header(self) -> list[str]:
-        rotational = not self.model.base_is_translational
-        return [f"{name} ({column_unit(name, rotational)})" for name in self.columns]
+        return [f"{name} ({column_unit(name, self._rotational(name))})" for name in self.columns]
+
+    def _rotational(self, name: str) -> bool:
+        """A base column about a rotation: a rotational 1-DOF base, or rows 4-6 of a 6-DOF one (x y z rx ry rz)."""
+        if self.model.m == 6:
+            prefix, _, row = name.removeprefix("shadow_").rpartition("_")
+            return prefix in ("xb", "xbdot", "fext", "reaction") and row in ("4", "5", "6")
+        return not self.model.base_is_translational
+
+    def wrench(self, k: int) -> tuple[float, ...]:
+        """The recorded reaction's base rows at step k (N, N m); () before the first evaluation."""
+        w = self.data[k, self._reaction]
+        return tuple(float(x) for x in w) if np.all(np.isfinite(w)) else ()
+
+    @cached_property
+    def _reaction(self) -> np.ndarray:
+        return np.array([self.index[name] for name in reaction_columns(self.model.m)], dtype=int)
 
     def csv(self) -> bytes:
         """Every step as CSV: a header with units, 17 significant digits (reads back bit-exact)."""
@@ -239,9 +263,11 @@ class Recorder:
         self._shadow_blocks = (slice(1, i["tau_1"] + n), slice(i["L_1"], i["L_1"] + r))
         shadow_names = [c for block in self._shadow_blocks for c in log.columns[block]]
         assert all(c.rsplit("_", 1)[0] in _SHADOW for c in shadow_names)
-        columns = (*log.columns, *(f"shadow_{c}" for c in shadow_names), *EXTRA)
+        extra = (*reaction_columns(runs.model.m), SUPPRESS)
+        self._extra = len(extra)
+        columns = (*log.columns, *(f"shadow_{c}" for c in shadow_names), *extra)
         self._log_width = w = len(log.columns)
-        self._shadow_into = (slice(w, w + i["tau_1"] + n - 1), slice(w + i["tau_1"] + n - 1, len(columns) - len(EXTRA)))
+        self._shadow_into = (slice(w, w + i["tau_1"] + n - 1), slice(w + i["tau_1"] + n - 1, len(columns) - len(extra)))
         capacity = round(self.seconds / runs.sim.dt)
         if self._data is None or columns != self.columns or len(self._data) != capacity:
             self._data = np.full((capacity, len(columns)), np.nan)
@@ -254,8 +280,9 @@ class Recorder:
     def __len__(self) -> int:
         return self._count
 
-    def append(self, runs: RunPair, shadow_on: bool, reaction: float, suppress: bool) -> None:
-        """Book the step just taken: the newest log rows of both runs (state at the step's start t)."""
+    def append(self, runs: RunPair, shadow_on: bool, wrench: tuple[float, ...], suppress: bool) -> None:
+        """Book the step just taken: the newest log rows of both runs (state at the step's start t) and
+        the reaction's base rows as last evaluated (``wrench``, m floats; () before the first: NaN)."""
         row_log = runs.sim.log.newest()
         if row_log is None:
             return
@@ -272,7 +299,7 @@ class Recorder:
             row[coupling_to] = shadow[coupling]
         else:
             row[state_to.start : coupling_to.stop] = np.nan
-        row[-2] = reaction
+        row[-self._extra : -1] = wrench if len(wrench) == self._extra - 1 else np.nan
         row[-1] = 1.0 if suppress else 0.0
         self._next = (self._next + 1) % len(data)
         self._count = min(self._count + 1, len(data))

@@ -11,7 +11,6 @@ the same code as live, from the recorded states.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import replace
 from typing import Protocol
@@ -20,6 +19,7 @@ from rns_viz.live import commands as c
 from rns_viz.live.operator import InputRefused
 from rns_viz.live.outputs import Outputs
 from rns_viz.live.pacing import Pacer
+from rns_viz.live.recorder import Recording
 from rns_viz.live.records import ReplayView, Snapshot
 from rns_viz.live.runs import RunPair
 from rns_viz.model import FsmsModel
@@ -87,6 +87,11 @@ def _back_to_live(state: ReplayHost, view: ReplayView) -> None:
         state.pacer.reanchor(state.runs.t)
 
 
+def readout_row(rec: Recording) -> int:
+    """The base row the reaction readout shows: the first selected one (as rns_viz.live.outputs)."""
+    return int(rec.model.selected[0])
+
+
 def replay_snapshot(live: Snapshot, now: float | None = None) -> Snapshot:
     """What to draw at wall time ``now``: the live snapshot, or during a replay the recorded step at the
     playhead in its place (t, q, the shadow's q, L, the reaction, suppression on or off)."""
@@ -97,11 +102,13 @@ def replay_snapshot(live: Snapshot, now: float | None = None) -> Snapshot:
     position = view.position(time.perf_counter() if now is None else now)
     k = rec.at(position)
     q_shadow = rec.q_shadow(k)
-    reaction = rec.value(k, "reaction")
+    wrench = rec.wrench(k)  # every base row of the reaction, as the live scene draws it
+    reaction = wrench[readout_row(rec)] if wrench else 0.0
     readouts = replace(
         live.readouts,
         L=rec.value(k, "L_1"),
-        reaction=reaction if math.isfinite(reaction) else 0.0,
+        reaction=reaction,
+        reaction_wrench=wrench,
         reaction_t=rec.value(k, "t"),
         sigma_hbm=rec.value(k, "sigma_hbm"),
     )

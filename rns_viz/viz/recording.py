@@ -63,7 +63,8 @@ def scene_file(
             q[:m] = np.clip(q[:m], -10.0 / max(exaggeration, 1e-9), 10.0 / max(exaggeration, 1e-9))
             with server.atomic():
                 scene.update(q, exaggeration)
-                scene.set_reaction_force(float(np.nan_to_num(snap.readouts.reaction)), REACTION_LABEL)
+                wrench = snap.readouts.reaction_wrench  # all six rows on a 6-DOF base: arrows as live
+                scene.set_reaction_force(float(np.nan_to_num(snap.readouts.reaction)), REACTION_LABEL, wrench)
                 teach.draw(snap, snap.q_shadow, exaggeration, view)
         return serializer.serialize()
     finally:
