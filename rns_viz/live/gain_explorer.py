@@ -37,6 +37,7 @@ from rns_viz.live.worker import Worker
 from rns_viz.sim import Simulator
 
 AUTHORITY_POINTS = 80  # configurations along the path / over the set where the decay is predicted
+AUTHORITY_CHUNK = 10  # configurations per helper call: other jobs (a new reachable set) go between calls
 FIT_FIRST_S = 4.0  # s after a kick before the first fit of the measured decay ...
 FIT_EVERY_S = 1.0  # ... and then every this many seconds ...
 FIT_UNTIL_S = 20.0  # ... until this long after it
@@ -119,12 +120,17 @@ class GainExplorer:
             return
         pick = np.unique(np.linspace(0, len(thetas) - 1, min(AUTHORITY_POINTS, len(thetas))).astype(int))
         thetas, points = np.asarray(thetas, dtype=float)[pick], np.asarray(ee, dtype=float)[pick]
-        model, law, _ = self._key
+        key = self._key
+        model, law, _ = key
         gains = self.view.gains
         self._publish(path_points=points, authority=None)
 
-        def job() -> tuple[list[LinearLoop], Authority]:
-            loops = jobs.call("linear_loops", model, law, thetas)
+        def job() -> tuple[list[LinearLoop], Authority] | None:
+            loops: list[LinearLoop] = []
+            for start in range(0, len(thetas), AUTHORITY_CHUNK):  # each call yields to waiting jobs
+                if self._key != key:
+                    return None  # stale: the model, law or configuration changed (collect drops it)
+                loops += jobs.call("linear_loops", model, law, thetas[start : start + AUTHORITY_CHUNK])
             return loops, authority(loops, gains.g_b, gains.g_m)
 
         self.worker.submit("along", self._key, job)
@@ -164,7 +170,7 @@ class GainExplorer:
                 self._publish(map=gain_map, **_at_fields(at))
             elif res.kind == "at" and res.tag[1] == self.view.gains:
                 self._publish(**_at_fields(res.value))
-            elif res.kind == "along":
+            elif res.kind == "along" and res.value is not None:  # None: abandoned when it went stale
                 self._loops, found = res.value
                 self._publish(authority=found)
             elif res.kind == "authority" and res.tag[1] == self.view.gains:

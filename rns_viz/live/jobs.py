@@ -7,6 +7,11 @@ speaking length-prefixed pickles over its stdin and stdout. :func:`call` runs on
 blocking the calling thread (not the GIL) until the result is back; the helper is started on
 first use, restarted if it died, and shared by all sessions of the process.
 
+One helper runs one job at a time. The gain explorer's linearisations (:data:`BACKGROUND_JOBS`) yield
+to every other job: a caller of those waits while one of the others waits, so a reachable set asked
+for after a change of S waits for at most the one explorer call in flight (the explorer cuts its
+sweep over a path into calls of a few configurations, rns_viz.live.gain_explorer).
+
 Jobs are the top-level functions below: plain arguments, picklable results.
 """
 
@@ -69,6 +74,7 @@ def linear_loops(name: str, law: LawKind, thetas: np.ndarray) -> list[LinearLoop
 
 
 JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region, linear_loop, loop_and_map, linear_loops)}
+BACKGROUND_JOBS = frozenset({"linear_loop", "loop_and_map", "linear_loops"})  # the gain explorer's: they yield
 
 
 class JobError(RuntimeError):
@@ -91,25 +97,43 @@ def _read(stream: IO[bytes]) -> Any:
 
 class _Helper:
     def __init__(self) -> None:
-        self.lock = threading.Lock()
+        self.cv = threading.Condition()
+        self.busy = False  # a job is in the helper
+        self.urgent_waiting = 0  # callers of jobs outside BACKGROUND_JOBS waiting for the helper
         self.proc: subprocess.Popen[bytes] | None = None
 
     def call(self, name: str, *args: Any) -> Any:
-        with self.lock:
-            for attempt in range(2):
-                proc = self._running()
-                try:
-                    assert proc.stdin is not None and proc.stdout is not None
-                    _write(proc.stdin, (name, args))
-                    ok, value = _read(proc.stdout)
-                    break
-                except (EOFError, BrokenPipeError, OSError):
-                    self.close()
-                    if attempt:
-                        raise JobError(f"the job helper died while running {name}") from None
+        urgent = name not in BACKGROUND_JOBS
+        with self.cv:
+            self.urgent_waiting += urgent
+            try:
+                self.cv.wait_for(lambda: not self.busy and (urgent or not self.urgent_waiting))
+            finally:
+                self.urgent_waiting -= urgent
+            self.busy = True
+        try:
+            ok, value = self._exchange(name, args)
+        finally:
+            with self.cv:
+                self.busy = False
+                self.cv.notify_all()
         if not ok:
             raise JobError(value)
         return value
+
+    def _exchange(self, name: str, args: tuple[Any, ...]) -> tuple[bool, Any]:
+        """Send one job and read its reply (restarting a dead helper once); the caller holds the helper."""
+        for attempt in range(2):
+            proc = self._running()
+            try:
+                assert proc.stdin is not None and proc.stdout is not None
+                _write(proc.stdin, (name, args))
+                return _read(proc.stdout)
+            except (EOFError, BrokenPipeError, OSError):
+                self.close()
+                if attempt:
+                    raise JobError(f"the job helper died while running {name}") from None
+        raise AssertionError("unreachable")
 
     def _running(self) -> subprocess.Popen[bytes]:
         if self.proc is None or self.proc.poll() is not None:
