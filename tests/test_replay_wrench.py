@@ -3,10 +3,13 @@ arrows (Eq. 1's −(H_bm θ'' + c_b), all six rows) as the live scene did at the
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from rns_viz.live.recorder import reaction_columns, read_csv
+from rns_viz.live.records import ReplayView
 from rns_viz.live.replay import replay_snapshot
 from rns_viz.live.session import Session
 from rns_viz.viz import recording as player
@@ -103,8 +106,4 @@ def test_csv_carries_the_wrench_with_units(boom7_run: tuple[Session, dict[float,
 
 def _replaying(live: object, rec: object, t: float) -> object:
     """``live`` with a paused replay of ``rec`` at ``t`` (what the loop publishes after a seek)."""
-    from dataclasses import replace
-
-    from rns_viz.live.records import ReplayView
-
     return replace(live, replay=ReplayView(rec, t, 0.0, 1.0, False, 0, True))
