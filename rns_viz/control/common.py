@@ -260,7 +260,7 @@ class CouplingEvaluator:
         cp = Coupling.__new__(Coupling)
         cp.M, cp.c, cp.H_bm, cp.thetadot = M, c, M[i : i + 1, m:], v[m:]
         cp.coupling_momentum, cp.inverse, cp.sigma = np.array((L,)), inverse, inverse.sigma_min
-        cp.row = CouplingRow(M_rows[i][i], v_values[i], hbm_dot.item(i), L, h, thetadot, M_rows)
+        cp.row = CouplingRow._make((M_rows[i][i], v_values[i], hbm_dot.item(i), L, h, thetadot, M_rows))
         cp._m, cp._rows, cp._H_b_index = m, self._rows, self._H_b_index
         cp._q, cp._v, cp._hbm_dot, cp._P = q, v, hbm_dot, None
         return cp
@@ -302,8 +302,7 @@ def _one_dof_base_torques(
     spring = -model.K_b.item(0) * q.item(0) - model.D_b.item(0) * v.item(0)
     accelerations = thetaddot.tolist()
     xddot_b = (spring - c.item(0) - sum(map(operator.mul, h, accelerations))) / H_b
-    tau = M[1:].dot(np.array((xddot_b, *accelerations)))
-    tau += c[1:]
+    tau = (M.dot(np.array((xddot_b, *accelerations))) + c)[1:]  # the arm rows: fewer numpy calls than M[1:]
     if model.has_joint_damping:
         tau += model.D_m @ v[1:]
     return tau

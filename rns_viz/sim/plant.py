@@ -20,8 +20,10 @@ class Plant:
 
     def __init__(self, model: FsmsModel) -> None:
         self.model = model
+        self._pin_model = model.pin_model  # read at every RK4 stage: one attribute, not a chain
         self._data = model.pin_model.createData()  # own data: the controller may use the model's
         m, nv = model.m, model.nv
+        self._m = m
         self._u = np.zeros(nv)  # generalised force tau_gen, rebuilt for each evaluation
         self._K, self._D, self._Dm = model.K_b, model.D_b, np.diag(model.D_m).copy()
         self._scalar_base = m == 1
@@ -43,7 +45,7 @@ class Plant:
     def hold(self, tau: np.ndarray, f_ext: np.ndarray | None) -> None:
         """Set the joint torques and base force used by :meth:`held_acceleration`."""
         self._tau = tau
-        self._u[self.model.m :] = tau
+        self._u[self._m :] = tau
         self._set_force(f_ext)
 
     def _set_force(self, f_ext: np.ndarray | None) -> None:
@@ -53,7 +55,7 @@ class Plant:
 
     def held_acceleration(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Generalised acceleration (x_b'', theta'') at (q, v) for the inputs set by :meth:`hold`."""
-        m, u = self.model.m, self._u
+        m, u = self._m, self._u
         if self._scalar_base:
             u[0] = -self._k * q.item(0) - self._d * v.item(0) + self._f0
         else:
@@ -62,7 +64,7 @@ class Plant:
                 u[:m] += self._f
         if self._arm_damped:
             u[m:] = self._tau - self._Dm * v[m:]
-        return pin.aba(self.model.pin_model, self._data, q, v, u)
+        return pin.aba(self._pin_model, self._data, q, v, u)
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None) -> np.ndarray:
         """Generalised acceleration (x_b'', theta'') for torques tau and base force f_ext."""
@@ -88,6 +90,8 @@ class Plant:
         """
         sampled = isinstance(f_ext, tuple)
         self.hold(tau, f_ext[0] if sampled else f_ext)  # type: ignore[index, arg-type]
+        if self._scalar_base:
+            return self._rk4_scalar_base(x, f_ext if sampled else None, dt)  # type: ignore[arg-type]
         q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
         xs[0][:] = x
         for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
@@ -96,6 +100,30 @@ class Plant:
             if sampled and s != 1:  # k_2 and k_3 at t + dt/2, k_4 at t + dt
                 self._set_force(f_ext[s // 2 + 1])  # type: ignore[index]
         a[3][:] = self.held_acceleration(q[3], v[3])
+        return x + self._weights(dt).dot(self._slopes)
+
+    def _rk4_scalar_base(self, x: np.ndarray, samples: StageForces | None, dt: float) -> np.ndarray:
+        """:meth:`rk4_state_step` for a 1-DOF base, inputs set by :meth:`hold`: the same stages, with
+        :meth:`held_acceleration`'s base force -k x_b - d x_b' + f as a number written inline and
+        everything it reads bound once (four stages per control step; TREP, the 3R, arm7)."""
+        q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
+        aba, pin_model, data, u, add = pin.aba, self._pin_model, self._data, self._u, np.add
+        k_b, d_b, tau, D_m, damped = self._k, self._d, self._tau, self._Dm, self._arm_damped
+        f = self._f0  # f(t); with samples, f(t + dt/2) for k_2, k_3 and f(t + dt) for k_4
+        if samples is None:
+            forces = (f, f, f, f)
+        else:
+            f_mid, f_end = (0.0 if g is None else float(g[0]) for g in samples[1:])
+            forces = (f, f_mid, f_mid, f_end)
+        xs[0][:] = x
+        for s, c in enumerate((0.5 * dt, 0.5 * dt, dt, None)):
+            q_s, v_s = q[s], v[s]
+            u[0] = -k_b * q_s.item(0) - d_b * v_s.item(0) + forces[s]
+            if damped:
+                u[1:] = tau - D_m * v_s[1:]
+            a[s][:] = aba(pin_model, data, q_s, v_s, u)
+            if c is not None:
+                add(x, c * k[s], xs[s + 1])
         return x + self._weights(dt).dot(self._slopes)
 
     def _weights(self, dt: float) -> np.ndarray:
