@@ -203,7 +203,7 @@ def null_vector(H_bm: np.ndarray) -> np.ndarray:
     if rows == 1:
         return np.stack([H[..., 0, 1], -H[..., 0, 0]], axis=-1)
     # all m + 1 minors in one batched determinant: (..., m + 1, m, m), column i left out of minor i
-    minors = np.linalg.det(np.swapaxes(H[..., _minor_columns(cols)], -3, -2))
+    minors = _lapack.det(np.swapaxes(H[..., _minor_columns(cols)], -3, -2), signature="d->d")  # np.linalg.det's call
     return minors * _ALTERNATING[:cols]
 
 
