@@ -6,7 +6,9 @@ OTHER_TREE is the root of another checkout (e.g. a git worktree of an older comm
 is ``Simulator.step()`` with ``native=False`` (law and RK4 in Python + pinocchio), law (15)
 ``AccelerationLaw`` with ``Gains(g_b=10, g_m=1)`` and its default null input, RK4 at 1 ms, logging
 on, starting at the model's default configuration with v0 = (0.01, 0, ...), for TREP, the 3R and
-the generated 7-DOF arm of ``benchmarks/oracles.py`` (arm7).
+the generated 7-DOF arm of ``benchmarks/oracles.py`` (arm7) and boom7 (13 DOF, six coupling rows).
+Also printed: the largest relative difference between the two trees' states after each round's
+steps (the same steps must give the same numbers: 0 for a pure speed-up).
 
 One subprocess per tree (its own imports), warmed up; the rounds alternate between them (which goes
 first alternating too), so both see the same machine load. A round builds a fresh simulator per model
@@ -28,12 +30,14 @@ import tempfile
 import time
 from pathlib import Path
 
-MODELS = ("trep", "planar3r", "arm7")
+import numpy as np
+
+MODELS = ("trep", "planar3r", "arm7", "boom7")
 
 
 def worker(steps: int, arm7_toml: str) -> None:
     """Serve rounds: for each line on stdin, time ``steps`` Python steps per model with the rns_viz found on
-    sys.path (a fresh simulator each round) and print µs/step (wall, CPU) as one JSON line."""
+    sys.path (a fresh simulator each round) and print µs/step (wall, CPU) and the final state as one JSON line."""
     import numpy as np
 
     from rns_viz.control import AccelerationLaw, Gains
@@ -58,11 +62,13 @@ def worker(steps: int, arm7_toml: str) -> None:
     for _ in sys.stdin:
         result = {}
         for name in MODELS:
-            step = simulator(name).step
+            sim = simulator(name)
+            step = sim.step
             t0, c0 = time.perf_counter(), time.process_time()
             for _ in range(steps):
                 step()
-            result[name] = (1e6 * (time.perf_counter() - t0) / steps, 1e6 * (time.process_time() - c0) / steps)
+            wall, cpu = 1e6 * (time.perf_counter() - t0) / steps, 1e6 * (time.process_time() - c0) / steps
+            result[name] = (wall, cpu, [*sim.q.tolist(), *sim.v.tolist()])
         print(json.dumps(result), flush=True)
 
 
@@ -117,6 +123,7 @@ def main() -> None:
     trees = {"this": here, "other": args.other.resolve()}
     clocks = ("wall", "cpu")
     times = {(tree, clock): {name: [] for name in MODELS} for tree in trees for clock in clocks}
+    states: dict[tuple[str, str], np.ndarray] = {}  # the state (q, v) after the last round's steps
     load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "arm7.urdf").write_text(arm7_urdf())
@@ -125,9 +132,10 @@ def main() -> None:
         for r in range(args.rounds):
             order = list(trees) if r % 2 == 0 else list(reversed(trees))
             for tree in order:
-                for name, (wall, cpu) in workers[tree].round().items():
+                for name, (wall, cpu, state) in workers[tree].round().items():
                     times[tree, "wall"][name].append(wall)
                     times[tree, "cpu"][name].append(cpu)
+                    states[tree, name] = np.array(state)
         for w in workers.values():
             w.close()
 
@@ -146,6 +154,10 @@ def main() -> None:
                 f"{min(a) / min(b):>11.3f}{med_a / med_b:>9.3f}"
             )
     print("µs per step; ratio = this / other (below 1: this tree is faster)")
+    for name in MODELS:
+        a, b = states["this", name], states["other", name]
+        rel = np.max(np.abs(a - b)) / np.max(np.abs(b))
+        print(f"{name:<10}final state, max |this - other| / max |other|: {rel:.1e}")
 
 
 if __name__ == "__main__":

@@ -26,6 +26,7 @@ class Plant:
         self._m = m
         self._u = np.zeros(nv)  # generalised force tau_gen, rebuilt for each evaluation
         self._K, self._D, self._Dm = model.K_b, model.D_b, np.diag(model.D_m).copy()
+        self._minus_K = -self._K  # (-K_b) x_b per evaluation: the negation done once
         self._scalar_base = m == 1
         self._k, self._d = float(self._K[0, 0]), float(self._D[0, 0])
         self._arm_damped = bool(np.any(self._Dm))
@@ -59,7 +60,7 @@ class Plant:
         if self._scalar_base:
             u[0] = -self._k * q.item(0) - self._d * v.item(0) + self._f0
         else:
-            u[:m] = -self._K @ q[:m] - self._D @ v[:m]
+            u[:m] = self._minus_K @ q[:m] - self._D @ v[:m]
             if self._f is not None:
                 u[:m] += self._f
         if self._arm_damped:

@@ -9,6 +9,8 @@ geometry functions are pure numpy (tested headless); :class:`BoomDrawing` sends 
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 import pinocchio as pin
 import viser
@@ -33,9 +35,7 @@ def boom_frames(
     a, b1, b2 = axes
     phi = pin.log3(rotation)  # rad, rotation vector of the tip
     slope = np.cross(phi, a)  # how the tip's tangent turned
-    xi = np.linspace(0.0, 1.0, stations)
-    bend, bend_d = 3 * xi**2 - 2 * xi**3, 6 * xi - 6 * xi**2
-    turn, turn_d = xi**3 - xi**2, 3 * xi**2 - 2 * xi
+    xi, bend, bend_d, turn, turn_d = _shape_functions(stations)
     line = np.outer(xi * (length + offset @ a), a)
     tangent = np.tile((length + offset @ a) * a, (stations, 1))
     for b in (b1, b2):
@@ -49,11 +49,31 @@ def boom_frames(
     return line, tangent, normal
 
 
+@cache
+def _shape_functions(stations: int) -> tuple[np.ndarray, ...]:
+    """xi and the Hermite shapes of :func:`boom_frames` (bend, turn and their xi-derivatives) at the
+    stations: the same every frame (two booms drawn per frame with the ghost), so computed once."""
+    xi = np.linspace(0.0, 1.0, stations)
+    shapes = (xi, 3 * xi**2 - 2 * xi**3, 6 * xi - 6 * xi**2, xi**3 - xi**2, 3 * xi**2 - 2 * xi)
+    for array in shapes:
+        array.flags.writeable = False
+    return shapes
+
+
+@cache
+def _ring(sides: int) -> tuple[np.ndarray, np.ndarray]:
+    """cos and sin of the tube's ``sides`` angles, (1, sides, 1) each (computed once)."""
+    angle = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
+    cos, sin = np.cos(angle)[None, :, None], np.sin(angle)[None, :, None]
+    cos.flags.writeable = sin.flags.writeable = False
+    return cos, sin
+
+
 def tube_vertices(line: np.ndarray, tangent: np.ndarray, normal: np.ndarray, radius: float, sides: int) -> np.ndarray:
     """Vertices (stations * sides, 3) of a tube of ``radius`` around the centre line."""
-    angle = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
+    cos, sin = _ring(sides)
     other = np.cross(tangent, normal)
-    ring = np.cos(angle)[None, :, None] * normal[:, None, :] + np.sin(angle)[None, :, None] * other[:, None, :]
+    ring = cos * normal[:, None, :] + sin * other[:, None, :]
     return (line[:, None, :] + radius * ring).reshape(-1, 3)
 
 

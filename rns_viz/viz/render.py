@@ -140,8 +140,9 @@ class Renderer:
         next_time = time.perf_counter()
         while not self._stop.is_set():
             try:
-                self._frame(next_time)
-                self.connections.panels.refresh()
+                with self.server.atomic():  # the frame's messages leave together: one event-loop wake-up, not one each
+                    self._frame(next_time)
+                    self.connections.panels.refresh()
             except Exception:  # drawing must never kill the app
                 traceback.print_exc()
             next_time += CROWDED_FRAME_S if self.connections.client_count() >= CROWD else FRAME_S
