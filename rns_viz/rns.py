@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from functools import cache
 
 import numpy as np
-from numpy.linalg import _umath_linalg as _lapack  # the LAPACK gufuncs behind np.linalg.svd and solve
 
 # Default singularity-robust settings: below ``threshold`` (smallest singular value, in the units
 # of the matrix) damping rises smoothly to ``max_damping`` (Nakamura & Hanafusa, 1986).
@@ -89,10 +88,10 @@ def _damping_squared(sigma: float, threshold: float, max_damping: float) -> floa
 def _any_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
     """Any number of rows: sigma_min from the SVD, then a solve with A A^T + lambda^2 E."""
     E = _identity(A.shape[0])
-    sigma = smallest_singular_value(A)
+    sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
     lam2 = _damping_squared(sigma, threshold, max_damping)
     G = A @ A.T + lam2 * E
-    inverse = A.T @ (np.linalg.solve(G, E) if sigma == 0.0 and lam2 == 0.0 else _lapack.solve(G, E, signature="dd->d"))
+    inverse = A.T @ np.linalg.solve(G, E)
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 
@@ -102,23 +101,6 @@ def _identity(rows: int) -> np.ndarray:
     E = np.eye(rows)
     E.flags.writeable = False
     return E
-
-
-def smallest_singular_value(A: np.ndarray) -> float:
-    """sigma_min of a float64 matrix: np.linalg.svd(A, compute_uv=False)[-1] by the same LAPACK call.
-
-    Per control step on a multi-row base (Eq. 15): numpy's gufunc is called directly, which skips
-    about 2 us of argument checks; a non-finite A raises LinAlgError as np.linalg.svd does."""
-    sigma = float(_lapack.svd(A, signature="d->d")[-1])
-    if not math.isfinite(sigma):
-        raise np.linalg.LinAlgError("SVD did not converge")
-    return sigma
-
-
-def solve_vector(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """np.linalg.solve(A, b) for a float64 square A that is positive definite (an inertia block) and a
-    vector b, by the same LAPACK call without numpy's per-call checks (every control step)."""
-    return _lapack.solve1(A, b, signature="dd->d")
 
 
 def _one_row(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
@@ -203,7 +185,7 @@ def null_vector(H_bm: np.ndarray) -> np.ndarray:
     if rows == 1:
         return np.stack([H[..., 0, 1], -H[..., 0, 0]], axis=-1)
     # all m + 1 minors in one batched determinant: (..., m + 1, m, m), column i left out of minor i
-    minors = _lapack.det(np.swapaxes(H[..., _minor_columns(cols)], -3, -2), signature="d->d")  # np.linalg.det's call
+    minors = np.linalg.det(np.swapaxes(H[..., _minor_columns(cols)], -3, -2))
     return minors * _ALTERNATING[:cols]
 
 

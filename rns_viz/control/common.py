@@ -17,7 +17,7 @@ from rns_viz.model import FsmsModel
 
 if TYPE_CHECKING:
     from rns_viz.control.reference import ReferenceSample
-from rns_viz.rns import DampedInverse, damped_pinv, damped_row_pinv, project_onto_rns, rns_projector, solve_vector
+from rns_viz.rns import DampedInverse, damped_pinv, damped_row_pinv, project_onto_rns, rns_projector
 
 LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
@@ -286,7 +286,7 @@ def _any_base_torques(
     """:func:`realize_acceleration` for an m-DOF base, as written there."""
     m, M, c = model.m, cp.M, cp.c
     rhs = -model.K_b @ q[:m] - model.D_b @ v[:m] - c[:m] - M[:m, m:] @ thetaddot
-    tau = M[:m, m:].T @ solve_vector(M[:m, :m], rhs) + M[m:, m:] @ thetaddot + c[m:]
+    tau = M[:m, m:].T @ np.linalg.solve(M[:m, :m], rhs) + M[m:, m:] @ thetaddot + c[m:]
     if model.has_joint_damping:
         tau += model.D_m @ v[m:]
     return tau
