@@ -13,11 +13,12 @@ import pytest
 from playwright.sync_api import Page
 
 from rns_viz.live.session import Session
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.app import RnsApp
 from rns_viz.viz.scene import FsmsScene
-from tests.browser import browser_page, requires_chromium, wait_for_nodes, wait_until
+from tests.app_helpers import realtime_app
+from tests.browser import browser_marks, browser_page, wait_for_nodes, wait_until
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 NOTICE = re.compile(r"Display slowed to \d+ Hz to keep up")
 SLOW_S = 120.0  # s: what a throttled software-rendered page may take for one step
@@ -35,9 +36,7 @@ SHOWN_TIME_JS = """() => {
 
 @pytest.fixture
 def trep_app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, verbose=False)
-    yield app
-    app.stop()
+    yield from realtime_app("trep")
 
 
 def paced_client(app: RnsApp) -> int:
