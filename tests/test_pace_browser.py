@@ -16,7 +16,7 @@ from rns_viz.live.session import Session
 from rns_viz.viz.app import RnsApp
 from rns_viz.viz.scene import FsmsScene
 from tests.app_helpers import realtime_app
-from tests.browser import browser_marks, browser_page, dismiss_notifications, wait_for_nodes, wait_until
+from tests.browser import browser_marks, browser_page, wait_for_nodes, wait_until
 
 pytestmark = browser_marks
 
@@ -70,26 +70,6 @@ def notice_shown(page: Page) -> bool:
     return any(lines.nth(k).is_visible() for k in range(lines.count()))
 
 
-def click_kick(page: Page, kicks: list[float], attempts: int = 3) -> None:
-    """A mouse click where the page shows its Kick button, until the kick reaches the session.
-
-    Playwright's own click would first watch the button over several animation frames of the throttled
-    page (minutes on a loaded machine); a mouse click at the button's place goes through the page's own
-    handlers all the same. A late toast may sit over the button and take a click: close toasts, find
-    the button again (the notice may have moved it) and click again, as a person would."""
-    for _ in range(attempts):
-        box = page.get_by_role("button", name="Kick the base").bounding_box(timeout=SLOW_S * 1000)
-        assert box is not None
-        page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
-        deadline = time.monotonic() + SLOW_S / 4
-        while not kicks and time.monotonic() < deadline:
-            time.sleep(0.1)
-        if kicks:
-            return
-        dismiss_notifications(page)
-    raise AssertionError(f"{attempts} clicks on the slowed page's Kick button did not reach the simulation")
-
-
 def test_a_throttled_page_is_slowed_told_so_still_operates_and_recovers(trep_app: RnsApp) -> None:
     app, s = trep_app, trep_app.session
     with browser_page(app.server) as page:
@@ -104,7 +84,8 @@ def test_a_throttled_page_is_slowed_told_so_still_operates_and_recovers(trep_app
         # The slowed page still operates the app: its Kick reaches the simulation, and the page goes on
         # to show the state after it.
         kicks = record_kicks(s)
-        click_kick(page, kicks)
+        page.get_by_role("button", name="Kick the base").click(timeout=SLOW_S * 1000)
+        wait_until(lambda: kicks, SLOW_S, "the slowed page's kick")
         wait_until(lambda: shown_time(page) >= kicks[0], SLOW_S, "the slowed page to show the kick's time", poll=1.0)
 
         # Unthrottled and with less to draw, the page catches up: full rate again, notice gone.
