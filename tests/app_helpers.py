@@ -1,9 +1,12 @@
-"""What the headless app tests share: a stepped app, a handle's uuid, waiting for queued commands."""
+"""What the app tests share: a stepped app, a real-time app, a stepped session, a lesson driver, a
+handle's uuid, waiting for queued commands."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from typing import Any
 
+from rns_viz.live.session import Session
 from rns_viz.viz.app import RnsApp, start_app
 from tests.browser import wait_until
 
@@ -14,6 +17,37 @@ def stepped_app(model: str) -> Iterator[RnsApp]:
     assert app.session.wait_background()
     yield app
     app.stop()
+
+
+def realtime_app(model: str, **options: Any) -> Iterator[RnsApp]:
+    """An app whose own loop runs the simulation in real time (as ``rns-viz`` does); stopped afterwards."""
+    app = start_app(model, port=0, verbose=False, **options)
+    yield app
+    app.stop()
+
+
+def stepped_session(model: str, background_s: float = 120.0) -> Iterator[Session]:
+    """A session without a server, stepped by the test, its background jobs (path, reachable set) done."""
+    s = Session(model, realtime=False)
+    assert s.wait_background(background_s)
+    yield s
+    s.stop()
+
+
+def run_lesson(
+    s: Session, model: str, number: int, student: Callable[[Session], None], background_s: float = 120.0
+) -> tuple[bool, str]:
+    """Start lesson ``number`` of ``model``, let ``student`` act; the lesson's (done, progress) after."""
+    s.start_lesson(model, number)
+    s.advance(0.01)
+    assert s.wait_background(background_s)  # the path or the reachable set of the lesson's start
+    s.advance(0.05)
+    status = s.snapshot().lesson
+    assert status is not None and status.number == number and not status.done
+    student(s)
+    status = s.snapshot().lesson
+    assert status is not None
+    return status.done, status.progress
 
 
 def uuid(handle: object) -> str:

@@ -45,6 +45,8 @@ def chromium_available() -> bool:
 requires_chromium = pytest.mark.skipif(
     not chromium_available() and os.environ.get("RNS_VIZ_REQUIRE_BROWSER") != "1", reason=SKIP_REASON
 )
+# What every real-browser test module starts with: ``pytestmark = browser_marks`` (or ``[*browser_marks, ...]``).
+browser_marks = [pytest.mark.browser, requires_chromium]
 
 
 def wait_until(condition: Callable[[], object], timeout: float, what: str, poll: float = 0.05) -> None:

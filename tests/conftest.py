@@ -1,4 +1,5 @@
-"""Shared fixtures: the bundled models, built once per session; stepped apps and a protocol client."""
+"""Shared fixtures: the bundled models, built once per session; stepped apps, boom7's stepped session and a
+protocol client."""
 
 from __future__ import annotations
 
@@ -6,9 +7,10 @@ from collections.abc import Iterator
 
 import pytest
 
+from rns_viz.live.session import Session
 from rns_viz.model import FsmsModel
 from rns_viz.viz.app import RnsApp
-from tests.app_helpers import stepped_app
+from tests.app_helpers import stepped_app, stepped_session
 from tests.browser import wait_for_clients
 from tests.protocol_client import ProtocolClient
 
@@ -32,6 +34,12 @@ def trep_app() -> Iterator[RnsApp]:
 @pytest.fixture
 def planar_app() -> Iterator[RnsApp]:
     yield from stepped_app("planar3r")
+
+
+@pytest.fixture
+def boom() -> Iterator[Session]:
+    """boom7's session, stepped by the test (no server), its path and reachable set computed."""
+    yield from stepped_session("boom7")
 
 
 @pytest.fixture

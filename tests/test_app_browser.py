@@ -6,23 +6,22 @@ from __future__ import annotations
 
 import time
 
-import pytest
 from playwright.sync_api import Page
 
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
+    browser_marks,
     browser_page,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 
 def click_track(page: Page, label: str, fraction: float) -> None:

@@ -27,7 +27,8 @@ from rns_viz.viz.app import TARGET_HANDLE, start_app
 from tests.browser import wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 
-DURATION_S = 30.0  # wall seconds of churn (the issue asks for 30 s)
+DURATION_S = 30.0  # wall seconds of churn when the real-time factor is asserted (the issue asks for 30 s)
+BEHAVIOUR_S = 10.0  # wall seconds of churn for the behaviour alone: some 60 connects and deaths of clients
 CHURNERS = 6  # plus the dragging operator and one steady watcher: 8 clients
 MIN_RTF = 0.95
 
@@ -80,8 +81,8 @@ class Churn:
     windows: list[float]
 
 
-def eight_clients_come_and_go_while_one_drags(capfd: pytest.CaptureFixture[str]) -> Churn:
-    """Run the churn on a fresh real-time app; assert what must hold whatever the machine's load.
+def eight_clients_come_and_go_while_one_drags(capfd: pytest.CaptureFixture[str], seconds: float) -> Churn:
+    """Run the churn for ``seconds`` (wall) on a fresh real-time app; assert what must hold whatever the machine's load.
 
     No divergence or pause during the churn; the operator's tab dying mid-drag ends the drag where it
     was and passes control on; the new operator's input counts; no traceback reaches the server log."""
@@ -97,7 +98,7 @@ def eight_clients_come_and_go_while_one_drags(capfd: pytest.CaptureFixture[str])
             [
                 sys.executable,
                 "-c",
-                f"from tests.test_app_clients import churn_process; churn_process({app.port}, {DURATION_S})",
+                f"from tests.test_app_clients import churn_process; churn_process({app.port}, {seconds})",
             ],
             cwd=Path(__file__).resolve().parents[1],
             stderr=subprocess.PIPE,
@@ -108,7 +109,7 @@ def eight_clients_come_and_go_while_one_drags(capfd: pytest.CaptureFixture[str])
         rtfs: list[float] = []
         k = 0
         dragger.drag_phase(TARGET_HANDLE, "start")
-        while time.perf_counter() - wall0 < DURATION_S:
+        while time.perf_counter() - wall0 < seconds:
             phase = 2 * math.pi * k / 200
             dragger.drag(TARGET_HANDLE, (ee[0] + 0.05 * math.sin(phase), ee[1] + 0.05 * math.cos(phase), ee[2]))
             if k % 50 == 49:
@@ -157,12 +158,12 @@ def test_eight_clients_come_and_go_while_one_drags(
     capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
 ) -> None:
     caplog.set_level(logging.WARNING)
-    eight_clients_come_and_go_while_one_drags(capfd)
+    eight_clients_come_and_go_while_one_drags(capfd, BEHAVIOUR_S)
     bad = [r for r in caplog.records if r.levelno >= logging.ERROR]
     assert not bad, [r.getMessage() for r in bad]
 
 
 @pytest.mark.perf
 def test_eight_clients_keep_real_time(capfd: pytest.CaptureFixture[str]) -> None:
-    churn = eight_clients_come_and_go_while_one_drags(capfd)
+    churn = eight_clients_come_and_go_while_one_drags(capfd, DURATION_S)
     assert churn.rtf >= MIN_RTF and np.median(churn.windows) >= MIN_RTF

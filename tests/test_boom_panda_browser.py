@@ -11,12 +11,13 @@ import numpy as np
 import pytest
 
 from rns_viz import robots
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
+from rns_viz.viz.app import TARGET_HANDLE, RnsApp
 from rns_viz.viz.scene import FsmsScene
+from tests.app_helpers import realtime_app
 from tests.browser import (
+    browser_marks,
     browser_page,
     dismiss_notifications,
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
@@ -24,8 +25,7 @@ from tests.browser import (
 )
 
 pytestmark = [
-    pytest.mark.browser,
-    requires_chromium,
+    *browser_marks,
     pytest.mark.skipif(
         not robots.is_installed("example-robot-data/panda"),
         reason="example-robot-data is not installed (pip install 'rns-viz[panda]')",
@@ -35,9 +35,7 @@ pytestmark = [
 
 @pytest.fixture
 def panda_app() -> Iterator[RnsApp]:
-    app = start_app("boom-panda", port=0, verbose=False)
-    yield app
-    app.stop()
+    yield from realtime_app("boom-panda")
 
 
 def test_boom_panda_in_chromium_shows_the_meshes_and_suppresses_a_kick(panda_app: RnsApp) -> None:

@@ -27,6 +27,7 @@ from rns_viz.viz.pace_control import (
     SLOW_ANSWER_S,
     PaceController,
 )
+from tests.app_helpers import realtime_app
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient
 
@@ -132,9 +133,7 @@ def test_the_gate_is_asked_before_each_window_but_not_inside_a_split_update() ->
 # ---------------------------------------------------------------- the app, protocol-level clients
 @pytest.fixture
 def trep_app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, verbose=False)
-    yield app
-    app.stop()
+    yield from realtime_app("trep")
 
 
 def client_id(app: RnsApp, before: set[int]) -> int:

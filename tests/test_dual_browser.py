@@ -14,16 +14,16 @@ from playwright.sync_api import Page
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
+    browser_marks,
     browser_page,
     dismiss_notifications,
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 # Screen position (px) of a point on a scene node's local x axis, ``offset`` m from its origin: the
 # client's camera matrices applied to the node's world matrix (three.js, column-major).

@@ -6,24 +6,23 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import pytest
 from playwright.sync_api import Page
 
 from rns_viz.viz.app import RnsApp
 from rns_viz.viz.gain_panel import QUANTITIES
 from rns_viz.viz.gain_scene import GainScene, axis_fraction
 from tests.browser import (
+    browser_marks,
     browser_page,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 
 def screen_point(page: Page, local: tuple[float, float, float]) -> tuple[float, float] | None:

@@ -10,6 +10,7 @@ import pytest
 
 from rns_viz.live.lessons import LESSONS
 from rns_viz.live.session import Session
+from tests.app_helpers import run_lesson
 
 
 @pytest.fixture(scope="module")
@@ -24,19 +25,6 @@ def planar_session() -> Iterator[Session]:
     s = Session("planar3r", realtime=False)
     yield s
     s.stop()
-
-
-def run_lesson(s: Session, model: str, number: int, student: Callable[[Session], None]) -> tuple[bool, str]:
-    s.start_lesson(model, number)
-    s.advance(0.01)
-    assert s.wait_background()  # the path or the reachable set of the lesson's start
-    s.advance(0.05)
-    status = s.snapshot().lesson
-    assert status is not None and status.number == number and not status.done
-    student(s)
-    status = s.snapshot().lesson
-    assert status is not None
-    return status.done, status.progress
 
 
 def kick_then(seconds: float, peak: float | None = None) -> Callable[[Session], None]:

@@ -11,29 +11,15 @@ import pytest
 
 from rns_viz.live.lessons import LESSONS
 from rns_viz.live.session import Session
+from tests.app_helpers import run_lesson, stepped_session
 
 SIDEWAYS = (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @pytest.fixture(scope="module")
 def boom() -> Iterator[Session]:
-    s = Session("boom7", realtime=False)
-    assert s.wait_background(120.0)
-    yield s
-    s.stop()
-
-
-def run_lesson(s: Session, number: int, student: Callable[[Session], None]) -> tuple[bool, str]:
-    s.start_lesson("boom7", number)
-    s.advance(0.01)
-    assert s.wait_background(120.0)
-    s.advance(0.05)
-    status = s.snapshot().lesson
-    assert status is not None and status.number == number and not status.done
-    student(s)
-    status = s.snapshot().lesson
-    assert status is not None
-    return status.done, status.progress
+    """One boom7 session for the module (each lesson restarts it from the lesson's start)."""
+    yield from stepped_session("boom7")
 
 
 def kick(s: Session, seconds: float = 2.5) -> None:
@@ -46,7 +32,7 @@ def test_boom7_has_three_lessons() -> None:
 
 
 def test_a_kick_suppressed_in_six_modes(boom: Session) -> None:
-    done, message = run_lesson(boom, 1, kick)
+    done, message = run_lesson(boom, "boom7", 1, kick)
     assert done, message
     assert "mrad" in message and "%" in message
 
@@ -56,7 +42,7 @@ def test_without_suppression_the_kick_lesson_is_not_done(boom: Session) -> None:
         s.set_suppression(False)  # the operated run rings; the shadow (suppression on) is the one that stops
         kick(s)
 
-    done, message = run_lesson(boom, 1, student)
+    done, message = run_lesson(boom, "boom7", 1, student)
     assert not done, message
 
 
@@ -66,12 +52,12 @@ def test_the_reactionless_path_keeps_the_boom_still(boom: Session) -> None:
         s.scrub(0.5 * lo)  # about 4 cm of hand motion
         s.advance(5.0)
 
-    done, message = run_lesson(boom, 2, student)
+    done, message = run_lesson(boom, "boom7", 2, student)
     assert done, message
 
 
 def test_a_kick_during_the_path_lesson_fails_it(boom: Session) -> None:
-    done, message = run_lesson(boom, 2, lambda s: kick(s, 0.5))
+    done, message = run_lesson(boom, "boom7", 2, lambda s: kick(s, 0.5))
     assert not done and "too much" in message
 
 
@@ -85,11 +71,11 @@ def drag(offset: tuple[float, float, float]) -> Callable[[Session], None]:
 
 
 def test_forces_only_tracking_keeps_the_force_rows_near_zero(boom: Session) -> None:
-    done, message = run_lesson(boom, 3, drag((0.04, -0.02, 0.02)))
+    done, message = run_lesson(boom, "boom7", 3, drag((0.04, -0.02, 0.02)))
     assert boom.snapshot().settings.model == "boom7#S=111000"
     assert done, message
 
 
 def test_a_short_drag_does_not_finish_the_forces_only_lesson(boom: Session) -> None:
-    done, message = run_lesson(boom, 3, drag((0.01, 0.0, 0.0)))
+    done, message = run_lesson(boom, "boom7", 3, drag((0.01, 0.0, 0.0)))
     assert not done and "Hand moved 1." in message

@@ -2,9 +2,11 @@
 
 For each lesson of TREP (6) and of the 3R (3) the page shows the lesson's panel and the scene after the
 lesson's task has been started by the operator (a kick, a play along the path, a dragged target ...).
-Screenshots go to ``artifacts/screenshots/``; the ones in ``docs/screenshots/`` are made with
+The default run walks one lesson per model; the walk through every lesson only makes the pictures, so it
+is marked ``docs`` (deselected by default). Screenshots go to ``artifacts/screenshots/``; the ones in
+``docs/screenshots/`` are made with
 
-    RNS_VIZ_SCREENSHOTS=docs/screenshots python -m pytest tests/test_lessons_browser.py
+    RNS_VIZ_SCREENSHOTS=docs/screenshots python -m pytest -m docs tests/test_lessons_browser.py
 """
 
 from __future__ import annotations
@@ -26,15 +28,15 @@ from rns_viz.viz.ghost import Ghost
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
     ARTIFACTS,
+    browser_marks,
     browser_page,
     dismiss_notifications,
-    requires_chromium,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, pytest.mark.slow, requires_chromium]
+pytestmark = [*browser_marks, pytest.mark.slow]
 SHOTS = Path(os.environ.get("RNS_VIZ_SCREENSHOTS", ARTIFACTS / "screenshots"))
 
 
@@ -85,15 +87,17 @@ def shoot(page: Page, name: str) -> Path:
     return path
 
 
-@pytest.mark.parametrize("model", ["trep", "planar3r", "boom7"])
-def test_walk_every_lesson_with_screenshots(model: str) -> None:
+def walk(model: str, numbers: list[int]) -> None:
+    """Open ``model``'s app at lesson 1 in the page, then start each lesson of ``numbers`` from the
+    session: the page shows its panel, the operator's action runs, the scene (and the ghost, when the
+    lesson shows the shadow run) is photographed; TREP's walk ends with a replay on the page's timeline."""
     app = start_app(model, port=0, verbose=False, lesson=1)
     try:
         s = app.session
         with browser_page(app.server, width=1400, height=900, timeout=60.0) as page:
             wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE}, timeout=60.0)
             count = len(LESSONS[model])
-            for number in range(1, count + 1):
+            for number in numbers:
                 s.start_lesson(model, number)
                 wait_until(
                     lambda n=number: (s.snapshot().lesson or object()).__dict__.get("number") == n, 20.0, "lesson"
@@ -123,3 +127,17 @@ def test_walk_every_lesson_with_screenshots(model: str) -> None:
                 s.stop_replay()
     finally:
         app.stop()
+
+
+# One lesson per model in the default run (every lesson's logic is checked headless in
+# tests/test_lessons.py and tests/test_lessons_boom.py): the ones with a ghost, and boom7's lesson on a
+# selected S (a model variant: boom7#S=111000) with a dragged target.
+@pytest.mark.parametrize(("model", "number"), [("trep", 4), ("planar3r", 3), ("boom7", 3)])
+def test_a_lesson_started_from_the_session_shows_in_the_page(model: str, number: int) -> None:
+    walk(model, [number])
+
+
+@pytest.mark.docs
+@pytest.mark.parametrize("model", ["trep", "planar3r", "boom7"])
+def test_walk_every_lesson_with_screenshots(model: str) -> None:
+    walk(model, list(range(1, len(LESSONS[model]) + 1)))

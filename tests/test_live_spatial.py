@@ -7,22 +7,12 @@ an RNS the app does not operate is refused with the reason and the runs are left
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import numpy as np
 import pytest
 
 from rns_viz.live.session import Session
 
 SIDEWAYS = (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)  # a kick along y: the boom's first bending mode
-
-
-@pytest.fixture
-def boom() -> Iterator[Session]:
-    s = Session("boom7", realtime=False)
-    assert s.wait_background(120.0)
-    yield s
-    s.stop()
 
 
 def test_a_kick_is_suppressed_in_all_six_modes_and_the_shadow_keeps_swinging(boom: Session) -> None:

@@ -13,11 +13,12 @@ import pytest
 from playwright.sync_api import Page
 
 from rns_viz.live.session import Session
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.app import RnsApp
 from rns_viz.viz.scene import FsmsScene
-from tests.browser import browser_page, requires_chromium, wait_for_nodes, wait_until
+from tests.app_helpers import realtime_app
+from tests.browser import browser_marks, browser_page, wait_for_nodes, wait_until
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 NOTICE = re.compile(r"Display slowed to \d+ Hz to keep up")
 SLOW_S = 120.0  # s: what a throttled software-rendered page may take for one step
@@ -35,9 +36,7 @@ SHOWN_TIME_JS = """() => {
 
 @pytest.fixture
 def trep_app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, verbose=False)
-    yield app
-    app.stop()
+    yield from realtime_app("trep")
 
 
 def paced_client(app: RnsApp) -> int:
@@ -107,7 +106,7 @@ def test_a_hidden_frozen_tab_answers_once_shown_and_shows_the_current_state(trep
         page.evaluate(HIDE_JS, True)
         cdp.send("Debugger.pause")  # the page's main thread stops, as in a frozen background tab
         wait_until(lambda: app.pace.state(client)["held"], 30.0, "the server to hold the frozen page's stream")
-        time.sleep(5.0)  # the simulation runs on meanwhile
+        time.sleep(2.0)  # the simulation runs on meanwhile (2 s of simulated time the page has not shown)
         cdp.send("Debugger.resume")
         cdp.send("Debugger.disable")
         page.evaluate(HIDE_JS, False)

@@ -20,15 +20,15 @@ from rns_viz.viz.app import RnsApp, start_app
 from rns_viz.viz.gui import PLANAR3R_PRESETS, TREP_PRESETS
 from rns_viz.viz.live_plots import SCALES
 from tests.browser import (
+    browser_marks,
     browser_page,
     dismiss_notifications,
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 RUN_S = 4.0  # s simulated per preset: every preset's kick or motion is over by then
 CHART_JS = """(uuid) => {

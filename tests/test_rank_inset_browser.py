@@ -9,22 +9,21 @@ import os
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from rns_viz.viz.app import start_app
 from rns_viz.viz.rank_inset import SIZE_PX
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
     ARTIFACTS,
+    browser_marks,
     browser_page,
     dismiss_notifications,
-    requires_chromium,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 SHOTS = Path(os.environ.get("RNS_VIZ_SCREENSHOTS", ARTIFACTS / "screenshots"))
 
 IMAGE_SIZE = """(label) => {

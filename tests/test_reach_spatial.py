@@ -6,7 +6,7 @@ one outside is held at the set's nearest point and the operator is told, r = 4 i
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
@@ -72,14 +72,6 @@ def test_region_clamps_a_far_target_to_its_nearest_reachable_point(forces_only: 
     assert moved and region.distance(held) <= region.radius + 1e-9
     nearest = region.points[np.argmin(np.linalg.norm(region.points - far, axis=1))]
     assert np.linalg.norm(held - far) <= np.linalg.norm(nearest - far) + 1e-12
-
-
-@pytest.fixture
-def boom() -> Iterator[Session]:
-    s = Session("boom7", realtime=False)
-    assert s.wait_background(120.0)
-    yield s
-    s.stop()
 
 
 def _reference_coupling(s: Session) -> float:

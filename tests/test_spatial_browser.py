@@ -14,9 +14,9 @@ import pytest
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
 from rns_viz.viz.scene import FsmsScene
 from tests.browser import (
+    browser_marks,
     browser_page,
     dismiss_notifications,
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
@@ -24,7 +24,7 @@ from tests.browser import (
 )
 from tests.test_app_browser import click_track
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 
 @pytest.fixture

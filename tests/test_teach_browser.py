@@ -29,17 +29,17 @@ from tests.browser import (
     ARTIFACTS,
     CHROMIUM,
     CHROMIUM_FLAGS,
+    browser_marks,
     browser_page,
     dismiss_notifications,
     local_position,
-    requires_chromium,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
-pytestmark = [pytest.mark.browser, requires_chromium]
+pytestmark = browser_marks
 
 
 @pytest.fixture
