@@ -45,8 +45,12 @@ def chromium_available() -> bool:
 requires_chromium = pytest.mark.skipif(
     not chromium_available() and os.environ.get("RNS_VIZ_REQUIRE_BROWSER") != "1", reason=SKIP_REASON
 )
+# The tests run in two pytest-xdist workers (pyproject's addopts). Everything that races the wall clock (a
+# browser, a server running in real time) goes to one worker, one test at a time, so two of them never
+# share the two cores; the headless tests fill the other worker.
+live_group = pytest.mark.xdist_group("live")
 # What every real-browser test module starts with: ``pytestmark = browser_marks`` (or ``[*browser_marks, ...]``).
-browser_marks = [pytest.mark.browser, requires_chromium]
+browser_marks = [pytest.mark.browser, requires_chromium, live_group]
 
 
 def wait_until(condition: Callable[[], object], timeout: float, what: str, poll: float = 0.05) -> None:

@@ -24,8 +24,10 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.app import TARGET_HANDLE, start_app
-from tests.browser import wait_until
+from tests.browser import live_group, wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
+
+pytestmark = live_group  # servers running in real time: one at a time (tests/browser.py)
 
 DURATION_S = 30.0  # wall seconds of churn when the real-time factor is asserted (the issue asks for 30 s)
 BEHAVIOUR_S = 10.0  # wall seconds of churn for the behaviour alone: some 60 connects and deaths of clients

@@ -28,8 +28,10 @@ from rns_viz.viz.pace_control import (
     PaceController,
 )
 from tests.app_helpers import realtime_app
-from tests.browser import wait_for_clients, wait_until
+from tests.browser import live_group, wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient
+
+pytestmark = live_group  # servers running in real time: one at a time (tests/browser.py)
 
 
 def answer(c: PaceController, now: float, after_s: float) -> float:
