@@ -84,10 +84,15 @@ def truncated_inverse(A: np.ndarray, rank: int, threshold: float) -> DampedInver
     value. With ``rank`` >= rows, the project's damped inverse."""
     if A.shape[0] <= rank:
         return damped_pinv(A, threshold, threshold)
-    U, s, Vt = np.linalg.svd(A, full_matrices=False)
+    return svd_inverse(*np.linalg.svd(A, full_matrices=False), rank, threshold)
+
+
+def svd_inverse(U: np.ndarray, s: np.ndarray, Vt: np.ndarray, rank: int, threshold: float) -> DampedInverse:
+    """:func:`truncated_inverse` from a thin SVD U diag(s) Vt already at hand: V diag(s / (s^2 + lambda^2)) U^T
+    over the ``rank`` largest singular values (with all of them, equal to :func:`damped_pinv`'s)."""
     U, s, Vt = U[:, :rank], s[:rank], Vt[:rank]
     lam2 = (1.0 - (s[-1] / threshold) ** 2) * threshold**2 if s[-1] < threshold else 0.0
-    return DampedInverse(Vt.T @ np.diag(s / (s**2 + lam2)) @ U.T, float(s[-1]), float(np.sqrt(lam2)))
+    return DampedInverse((Vt.T * (s / (s**2 + lam2))) @ U.T, float(s[-1]), float(np.sqrt(lam2)))
 
 
 def _damping_squared(sigma: float, threshold: float, max_damping: float) -> float:

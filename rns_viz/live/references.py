@@ -22,7 +22,7 @@ from rns_viz.live.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic
-from rns_viz.rns import DampedInverse, null_vector, rns_projector, truncated_inverse
+from rns_viz.rns import DampedInverse, null_vector, rns_projector, svd_inverse, truncated_inverse
 
 
 class SigmaMotion:
@@ -271,13 +271,12 @@ class ResolvedRate(SmoothedTarget):
         return truncated_inverse(J_bar, self.model.n - len(self.model.selected), self.threshold)
 
     def orientation_rate(
-        self, J_bar: np.ndarray, P: np.ndarray, J_o: np.ndarray, R: np.ndarray, thetadot_p: np.ndarray
+        self, V: np.ndarray, P: np.ndarray, J_o: np.ndarray, R: np.ndarray, thetadot_p: np.ndarray
     ) -> np.ndarray:
-        """The secondary task: N (J_o N)^+ (w - J_o theta_p'), N = P - J-bar^+ J-bar (the RNS directions that
-        leave the hand's position still), w = k log3(R_d R^T) limited to ``omega_max``; least squares when N
-        has fewer than 3 directions (``orient_dof``)."""
-        rank_p = min(J_bar.shape[0], self.model.n - len(self.model.selected))
-        V = np.linalg.svd(J_bar, full_matrices=False)[2][:rank_p]
+        """The secondary task: N (J_o N)^+ (w - J_o theta_p'), N = P - V^T V = P - J-bar^+ J-bar (the RNS
+        directions that leave the hand's position still; V: J-bar's right singular vectors of its nonzero
+        singular values), w = k log3(R_d R^T) limited to ``omega_max``; least squares when N has fewer
+        than 3 directions (``orient_dof``)."""
         N = P - V.T @ V
         w = self.k * pin.log3(self.goal_R @ R.T)
         w_norm = float(np.sqrt(w @ w))
@@ -323,7 +322,9 @@ class ResolvedRate(SmoothedTarget):
             at_goal = False
         P = self._projector(q)
         J_bar = J @ P
-        inverse = self._inverse(J_bar)
+        rank = min(len(self.rows), self.model.n - len(self.model.selected))
+        svd = np.linalg.svd(J_bar, full_matrices=False) if self.orienting else None  # one SVD for both tasks
+        inverse = self._inverse(J_bar) if svd is None else svd_inverse(*svd, rank, self.threshold)
         self.sigma_jbar = inverse.sigma_min
         thetadot = P @ (inverse.inverse @ (f.v + self.k * (f.x - x)))
         speed = float(np.sqrt(thetadot @ thetadot))
@@ -332,7 +333,7 @@ class ResolvedRate(SmoothedTarget):
         self.theta_dot_o = np.zeros_like(thetadot)
         if self.orienting:  # orthogonal to the primary part: it gets the joint speed the position leaves
             R = base.rotation.T @ data.oMf[self.model.ee_frame_id].rotation
-            th_o = self.orientation_rate(J_bar, P, base.rotation.T @ J_six[3:], R, thetadot)
+            th_o = self.orientation_rate(svd[2][:rank], P, base.rotation.T @ J_six[3:], R, thetadot)  # type: ignore[index]
             room = float(np.sqrt(max(0.0, self.joint_speed**2 - float(thetadot @ thetadot))))
             speed_o = float(np.sqrt(th_o @ th_o))
             self.theta_dot_o = th_o * (room / speed_o) if speed_o > room else th_o
