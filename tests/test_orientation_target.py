@@ -204,3 +204,35 @@ def test_at_r_5_sigma_jbar_is_the_second_singular_value_and_orientation_is_refus
     refused = [n for n in s.pop_notices() if n.title == "Input not applied"]
     assert refused and "not offered" in refused[0].body
     assert not s.snapshot().paused
+
+
+def test_bad_quaternions_from_a_client_are_told_and_the_simulation_runs_on() -> None:
+    """The handle's drag with a NaN or zero quaternion, as a client could send it (tests/protocol_client.py)."""
+    from rns_viz.viz.app import TARGET_HANDLE
+    from tests.app_helpers import stepped_app
+    from tests.browser import wait_for_clients, wait_until
+    from tests.protocol_client import ProtocolClient
+
+    apps = stepped_app("boom7")
+    app = next(apps)
+    ws = ProtocolClient(app.port, decode=True)
+    try:
+        s = app.session
+        s.set_selection(R1)
+        s.advance(0.01)
+        wait_until(lambda: app.controls.pose_target, 20.0, "the pose handle")
+        wait_for_clients(app, 1, "the websocket client")
+        before = np.array(s.snapshot().target, dtype=float)
+        lifted = before + app.controls.target_lift + np.array([0.02, 0.0, 0.0])
+        for bad in ((np.nan, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0)):
+            ws.drag(TARGET_HANDLE, tuple(lifted), "end", wxyz=bad)
+        wait_until(lambda: ws.types["NotificationShowMessage"] >= 2, 10.0, "one notice per bad quaternion")
+        assert "DragTarget" not in s.pending_commands()  # refused before anything was queued
+        t0 = s.snapshot().t
+        s.advance(0.5)
+        snap = s.snapshot()
+        assert not snap.paused and snap.diverged is None and snap.t == pytest.approx(t0 + 0.5)
+        assert np.allclose(snap.target, before)  # the target in force is untouched
+    finally:
+        ws.close()
+        apps.close()

@@ -134,13 +134,15 @@ def test_boom7_r1_pose_target_turns_the_hand_with_the_rotation_rings(boom_app: R
         wait_until(lambda: "3 of 3 rotational DOF free" in note.content, 20.0, "the orientation note")
         handle = app.renderer.handle
         wait_until(lambda: not handle.disable_rotations and app.controls.pose_target, 20.0, "the rotation rings")
-        assert page.get_by_text("track orientation").first.is_visible()
+        label = page.get_by_text("track orientation", exact=True)
+        wait_until(lambda: label.count() > 0, 20.0, "the box on the page")
         model = s.state.model
         rr = s.state.operator.rr  # type: ignore[union-attr]
         goal = rns_walk(model, s.snapshot().q[6:], seed=5, steps=250)
         x_goal, R_goal = rr.ee(goal), rr.ee_rotation(goal)
         q = pin.Quaternion(R_goal)
         s.set_target(x_goal, True, None, (q.w, q.x, q.y, q.z))  # what Controls.on_drag sends at a drag's end
+        wait_until(lambda: np.allclose(s.snapshot().target, x_goal), 10.0, "the pose target taken")
         wait_until(lambda: not s.state.operator.busy, 30.0, "the arm to arrive")  # type: ignore[union-attr]
         time.sleep(1.0)  # the simulated arm settles on the reference
         theta = s.snapshot().q[6:]
@@ -149,7 +151,7 @@ def test_boom7_r1_pose_target_turns_the_hand_with_the_rotation_rings(boom_app: R
         wait_until(lambda: abs(float(np.dot(handle.wxyz, want))) > 1 - 1e-6, 10.0, "the handle turned to the goal")
         app.scene.set_initial_camera()
         page.mouse.move(5, 5)
-        page.get_by_text("track orientation").first.scroll_into_view_if_needed()
+        label.first.scroll_into_view_if_needed()
         dismiss_notifications(page)
         wait_for_frames(page, 30)
         assert screenshot(page, "app_boom7_orientation").stat().st_size > 10_000
