@@ -9,8 +9,9 @@ returns what changed for the loop to act on.
 scrub slider, quintic plays and cyclic motion all move sigma = integral of u-bar dt (Eq. 30); the
 point-to-point comparison leaves the path on a joint-space quintic between the same end points.
 
-Multi-dimensional RNS (planar 3R): the target is clamped to the reactionless reachable set and
-followed by the :class:`ResolvedRate` reference.
+Multi-dimensional RNS (planar 3R, boom7 with r <= 5): the target is clamped to the reactionless
+reachable set and followed by the :class:`ResolvedRate` reference; in space with n - r >= 4 its
+orientation too, as a secondary task (the laws (15)/(16) then follow theta_ref, see :meth:`Operator.law_task`).
 
 Dual arms (trep2): the target is clamped to the task arm's workspace and followed by the task arm
 (:class:`~rns_viz.live.dual.TaskTarget`); the compensating arm cancels the reaction.

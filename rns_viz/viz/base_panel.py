@@ -1,6 +1,7 @@
 """The panel of a base with several coordinates (boom7: x, y, z, rx, ry, rz): the kick's direction,
 the selection S (which reactions must vanish, Sec. III-B) with the reaction null space's dimension
-n - r, and a live plot of every base coordinate. Hidden for a 1-DOF base.
+n - r, whether the handle's orientation is tracked too (n - r >= 4: rotational DOF left over), and a
+live plot of every base coordinate. Hidden for a 1-DOF base.
 
 The checkboxes make one typed command (:class:`~rns_viz.live.commands.SetSelection`) the loop
 applies; what the loop refuses (an RNS the app does not operate) comes back as a notice and the
