@@ -222,7 +222,8 @@ class ResolvedRate(SmoothedTarget):
         self.orienting = self.orient_dof > 0  # track the goal orientation (secondary task)
         self.omega_max = 1.0  # rad/s: the orientation error's commanded rate at most
         self.goal_R = np.eye(3)  # goal orientation of the end effector, base frame
-        self.theta_dot_o = np.zeros(model.n)  # rad/s: the secondary (orientation) part of theta_ref'
+        self._still = np.zeros(model.n)  # rad/s, never written to
+        self.theta_dot_o = self._still  # rad/s: the secondary (orientation) part of theta_ref'
         self.reset(theta)
 
     def reset(self, theta: np.ndarray, keep_goal: bool = False) -> None:
@@ -330,7 +331,7 @@ class ResolvedRate(SmoothedTarget):
         speed = float(np.sqrt(thetadot @ thetadot))
         if speed > self.joint_speed:
             thetadot *= self.joint_speed / speed
-        self.theta_dot_o = np.zeros_like(thetadot)
+        self.theta_dot_o = self._still
         if self.orienting:  # orthogonal to the primary part: it gets the joint speed the position leaves
             R = base.rotation.T @ data.oMf[self.model.ee_frame_id].rotation
             th_o = self.orientation_rate(svd[2][:rank], P, base.rotation.T @ J_six[3:], R, thetadot)  # type: ignore[index]
@@ -343,14 +344,14 @@ class ResolvedRate(SmoothedTarget):
         )
         if self.blocked:  # the way to the target crosses a singular curve of J-bar: stop before it
             thetadot = np.zeros_like(thetadot)
-            self.theta_dot_o = np.zeros_like(thetadot)
+            self.theta_dot_o = self._still
             f.x, f.v = x.copy(), np.zeros_like(f.v)
             at_goal = False
         xdot = J @ thetadot
         self.xddot = (xdot - self.xdot) / dt
         self.x, self.xdot, self.thetadot = x, xdot, thetadot
         self._next = self.theta + thetadot * dt
-        turning = float(np.sqrt(self.theta_dot_o @ self.theta_dot_o)) > 1e-6  # rad/s
+        turning = self.orienting and float(np.sqrt(self.theta_dot_o @ self.theta_dot_o)) > 1e-6  # rad/s
         if at_goal and float(np.abs(f.x - x).max()) < 1e-6 and not turning:
             self.idle, self._next = True, None
             self.thetadot = np.zeros_like(thetadot)
