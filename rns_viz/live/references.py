@@ -198,6 +198,10 @@ class ResolvedRate(SmoothedTarget):
     1 kHz controller as base vibration.
     """
 
+    # rad/s: the orientation is done once its joint rate falls below this (least squares: it creeps on toward
+    # the best orientation reachable; what is left then is ~ TURN_TOL / k ~ 1e-5 rad)
+    TURN_TOL = 1e-4
+
     def __init__(
         self,
         model: FsmsModel,
@@ -264,6 +268,10 @@ class ResolvedRate(SmoothedTarget):
         J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
         J = (data.oMi[self.model.base_joint_id].rotation.T @ J_world)[self.rows]
         return self._inverse(J @ self._projector(q)).sigma_min
+
+    def _toward_fold(self, thetadot: np.ndarray) -> bool:
+        """Close to a singular curve of J-bar (sigma_min below ``stop_sigma``) and ``thetadot`` goes closer."""
+        return self.sigma_jbar < self.stop_sigma and self._sigma_at(self.theta + 0.05 * thetadot) < self.sigma_jbar
 
     def _inverse(self, J_bar: np.ndarray) -> DampedInverse:
         """J-bar^+, damped below ``threshold``. With fewer RNS directions than task rows (boom7, r = 5: a 2-D
@@ -339,9 +347,9 @@ class ResolvedRate(SmoothedTarget):
             speed_o = float(np.sqrt(th_o @ th_o))
             self.theta_dot_o = th_o * (room / speed_o) if speed_o > room else th_o
             thetadot = thetadot + self.theta_dot_o
-        self.blocked = (
-            self.sigma_jbar < self.stop_sigma and self._sigma_at(self.theta + 0.05 * thetadot) < self.sigma_jbar
-        )
+        if self.orienting and self._toward_fold(thetadot):  # the turn would lead into a fold: not from here
+            thetadot, self.theta_dot_o = thetadot - self.theta_dot_o, self._still
+        self.blocked = self._toward_fold(thetadot)
         if self.blocked:  # the way to the target crosses a singular curve of J-bar: stop before it
             thetadot = np.zeros_like(thetadot)
             self.theta_dot_o = self._still
@@ -351,7 +359,7 @@ class ResolvedRate(SmoothedTarget):
         self.xddot = (xdot - self.xdot) / dt
         self.x, self.xdot, self.thetadot = x, xdot, thetadot
         self._next = self.theta + thetadot * dt
-        turning = self.orienting and float(np.sqrt(self.theta_dot_o @ self.theta_dot_o)) > 1e-6  # rad/s
+        turning = self.orienting and float(np.sqrt(self.theta_dot_o @ self.theta_dot_o)) > self.TURN_TOL
         if at_goal and float(np.abs(f.x - x).max()) < 1e-6 and not turning:
             self.idle, self._next = True, None
             self.thetadot = np.zeros_like(thetadot)
