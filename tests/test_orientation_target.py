@@ -7,6 +7,7 @@ differences; bad quaternions are refused and the simulation runs on.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 
 import numpy as np
@@ -227,11 +228,13 @@ def test_bad_quaternions_from_a_client_are_told_and_the_simulation_runs_on() -> 
         lifted = before + app.controls.target_lift + np.array([0.02, 0.0, 0.0])
         for bad in ((np.nan, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0)):
             told = ws.types["NotificationShowMessage"]
-            ws.drag(TARGET_HANDLE, tuple(lifted), "end", wxyz=bad)
+            # mid-drag updates (at a drag's end viser calls back once more with the handle as it is then)
+            ws.drag(TARGET_HANDLE, tuple(lifted), "update", wxyz=bad)
             wait_until(lambda told=told: ws.types["NotificationShowMessage"] > told, 10.0, "a notice")
             # the refused drag sends the handle home (render thread); wait for it before the next drag,
             # whose callback would otherwise read the handle's pose as the renderer set it
             wait_until(lambda: not app.controls._handle_home_requested, 10.0, "the handle sent home")
+            time.sleep(0.5)  # the render frame that took the request writes the handle's pose (30 Hz frames)
         assert "DragTarget" not in s.pending_commands()  # refused before anything was queued
         t0 = s.snapshot().t
         s.advance(0.5)

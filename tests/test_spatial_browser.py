@@ -85,6 +85,9 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (README)
         s.set_selection((True, True, True, False, False, False))  # what ticking off rx, ry, rz sends
         wait_until(lambda: s.snapshot().settings.model == "boom7#S=111000", 20.0, "the forces-only selection")
+        s.track_orientation(False)  # a position handle: a pose handle's arrows turn with the hand's orientation
+        off = s.snapshot
+        wait_until(lambda: not off().orientation.on and not app.controls.pose_target, 20.0, "the position handle")  # type: ignore[union-attr]
         wait_until(lambda: s.overlays().reach is not None, 60.0, "the reachable set")
         wait_until(lambda: app.scene.reachable.visible, 20.0, "the reachable set drawn")
         assert len(s.overlays().reach) > 100 and "involutive" in s.overlays().reach_note  # type: ignore[arg-type]
