@@ -78,6 +78,23 @@ def damped_pinv(
     return _any_rows(A, threshold, max_damping)
 
 
+def truncated_inverse(A: np.ndarray, rank: int, threshold: float) -> DampedInverse:
+    """A^+ of a wide matrix of rank ``rank`` at most (fewer than its rows): inverted on the span of its
+    ``rank`` largest singular values, damped below ``threshold``; sigma_min is the rank-th singular
+    value. With ``rank`` >= rows, the project's damped inverse."""
+    if A.shape[0] <= rank:
+        return damped_pinv(A, threshold, threshold)
+    return svd_inverse(*np.linalg.svd(A, full_matrices=False), rank, threshold)
+
+
+def svd_inverse(U: np.ndarray, s: np.ndarray, Vt: np.ndarray, rank: int, threshold: float) -> DampedInverse:
+    """:func:`truncated_inverse` from a thin SVD U diag(s) Vt already at hand: V diag(s / (s^2 + lambda^2)) U^T
+    over the ``rank`` largest singular values (with all of them, equal to :func:`damped_pinv`'s)."""
+    U, s, Vt = U[:, :rank], s[:rank], Vt[:rank]
+    lam2 = (1.0 - (s[-1] / threshold) ** 2) * threshold**2 if s[-1] < threshold else 0.0
+    return DampedInverse((Vt.T * (s / (s**2 + lam2))) @ U.T, float(s[-1]), float(np.sqrt(lam2)))
+
+
 def _damping_squared(sigma: float, threshold: float, max_damping: float) -> float:
     """lambda^2 of the damped inverse for smallest singular value sigma (0 above ``threshold``)."""
     if sigma >= threshold:

@@ -85,6 +85,9 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (README)
         s.set_selection((True, True, True, False, False, False))  # what ticking off rx, ry, rz sends
         wait_until(lambda: s.snapshot().settings.model == "boom7#S=111000", 20.0, "the forces-only selection")
+        s.track_orientation(False)  # a position handle: a pose handle's arrows turn with the hand's orientation
+        off = s.snapshot
+        wait_until(lambda: not off().orientation.on and not app.controls.pose_target, 20.0, "the position handle")  # type: ignore[union-attr]
         wait_until(lambda: s.overlays().reach is not None, 60.0, "the reachable set")
         wait_until(lambda: app.scene.reachable.visible, 20.0, "the reachable set drawn")
         assert len(s.overlays().reach) > 100 and "involutive" in s.overlays().reach_note  # type: ignore[arg-type]
@@ -114,3 +117,44 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         dismiss_notifications(page)
         wait_for_frames(page, 30)
         assert screenshot(page, "app_boom7_reach").stat().st_size > 10_000
+
+
+def test_boom7_r1_pose_target_turns_the_hand_with_the_rotation_rings(boom_app: RnsApp) -> None:
+    """r = 1 (n - r = 6): the "track orientation" box is ticked by default, the handle gets rotation rings,
+    and a pose set through the call the handle makes is reached by the simulated arm."""
+    import pinocchio as pin
+
+    from tests.test_orientation_target import angle_deg, rns_walk
+
+    app, s = boom_app, boom_app.session
+    with browser_page(app.server, width=1400, height=900) as page:
+        wait_for_nodes(page, {FsmsScene.BASE, TARGET_HANDLE, "/boom/tube"}, timeout=60.0)
+        dismiss_notifications(page)
+        s.set_selection((True, False, False, False, False, False))  # what ticking off S2..S6 sends
+        wait_until(lambda: s.snapshot().settings.model == "boom7#S=100000", 20.0, "the r = 1 selection")
+        box, note = app.base_panel.orientation, app.base_panel.orientation_note
+        wait_until(lambda: box.visible and box.value and not box.disabled, 20.0, "the orientation box ticked")
+        wait_until(lambda: "3 of 3 rotational DOF free" in note.content, 20.0, "the orientation note")
+        handle = app.renderer.handle
+        wait_until(lambda: not handle.disable_rotations and app.controls.pose_target, 20.0, "the rotation rings")
+        label = page.get_by_text("track orientation", exact=True)
+        wait_until(lambda: label.count() > 0, 20.0, "the box on the page")
+        model = s.state.model
+        rr = s.state.operator.rr  # type: ignore[union-attr]
+        goal = rns_walk(model, s.snapshot().q[6:], seed=5, steps=250)
+        x_goal, R_goal = rr.ee(goal), rr.ee_rotation(goal)
+        q = pin.Quaternion(R_goal)
+        s.set_target(x_goal, True, None, (q.w, q.x, q.y, q.z))  # what Controls.on_drag sends at a drag's end
+        wait_until(lambda: np.allclose(s.snapshot().target, x_goal), 10.0, "the pose target taken")
+        wait_until(lambda: not s.state.operator.busy, 30.0, "the arm to arrive")  # type: ignore[union-attr]
+        time.sleep(1.0)  # the simulated arm settles on the reference
+        theta = s.snapshot().q[6:]
+        assert np.linalg.norm(rr.ee(theta) - x_goal) < 3e-3 and angle_deg(rr.ee_rotation(theta), R_goal) < 1.5
+        want = np.array([q.w, q.x, q.y, q.z])
+        wait_until(lambda: abs(float(np.dot(handle.wxyz, want))) > 1 - 1e-6, 10.0, "the handle turned to the goal")
+        app.scene.set_initial_camera()
+        page.mouse.move(5, 5)
+        label.first.scroll_into_view_if_needed()
+        dismiss_notifications(page)
+        wait_for_frames(page, 30)
+        assert screenshot(page, "app_boom7_orientation").stat().st_size > 10_000

@@ -167,6 +167,7 @@ class SetShadow(Command):
 class DragTarget(Command):
     xy: tuple[float, ...]  # m, base frame: (x, y) in the task plane of a planar model, (x, y, z) in space
     final: bool = False  # the end of a drag
+    wxyz: tuple[float, ...] | None = None  # goal orientation (unit quaternion, base frame) of a pose handle
 
     def __post_init__(self) -> None:
         try:
@@ -177,6 +178,28 @@ class DragTarget(Command):
             raise ValueError(f"target must be 2 or 3 finite coordinates within {MAX_TARGET_M:g} m, got {self.xy!r}")
         _switch("end of drag", self.final)
         object.__setattr__(self, "xy", tuple(float(v) for v in xy))
+        if self.wxyz is not None:
+            object.__setattr__(self, "wxyz", _unit_quaternion(self.wxyz))
+
+
+def _unit_quaternion(wxyz: Any) -> tuple[float, ...]:
+    """A target orientation (w, x, y, z), normalised; refused unless four finite numbers of norm ~1."""
+    try:
+        q = np.asarray(wxyz, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"target orientation must be a quaternion (w, x, y, z), got {wxyz!r}") from exc
+    norm = float(np.sqrt(q @ q)) if q.size == 4 and np.all(np.isfinite(q)) else 0.0
+    if not 0.5 < norm < 2.0:
+        raise ValueError(f"target orientation must be a unit quaternion (w, x, y, z), got {wxyz!r}")
+    return tuple(float(v) for v in q / norm)
+
+
+@dataclass(frozen=True)
+class TrackOrientation(Command):
+    on: bool  # spatial models: the end effector also follows the handle's orientation (secondary task)
+
+    def __post_init__(self) -> None:
+        _switch("orientation tracking", self.on)
 
 
 @dataclass(frozen=True)
@@ -312,6 +335,7 @@ TIMED = (
     SetUbarSpeed,
     SetTargetSpeed,
     DragTarget,
+    TrackOrientation,
     Scrub,
     Play,
     Cyclic,

@@ -9,8 +9,9 @@ returns what changed for the loop to act on.
 scrub slider, quintic plays and cyclic motion all move sigma = integral of u-bar dt (Eq. 30); the
 point-to-point comparison leaves the path on a joint-space quintic between the same end points.
 
-Multi-dimensional RNS (planar 3R): the target is clamped to the reactionless reachable set and
-followed by the :class:`ResolvedRate` reference.
+Multi-dimensional RNS (planar 3R, boom7 with r <= 5): the target is clamped to the reactionless
+reachable set and followed by the :class:`ResolvedRate` reference; in space with n - r >= 4 its
+orientation too, as a secondary task (the laws (15)/(16) then follow theta_ref, see :meth:`Operator.law_task`).
 
 Dual arms (trep2): the target is clamped to the task arm's workspace and followed by the task arm
 (:class:`~rns_viz.live.dual.TaskTarget`); the compensating arm cancels the reaction.
@@ -21,11 +22,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from rns_viz.control import JointSample, TaskSample
 from rns_viz.live.dual import TaskTarget, is_dual
 from rns_viz.live.path_table import PathTable
 from rns_viz.live.reach import ReachRegion
+from rns_viz.live.records import OrientationView
 from rns_viz.live.references import PathFollower, ResolvedRate, SigmaMotion
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import QuinticSegment
@@ -47,6 +50,18 @@ SNAP_TOLERANCE_M = 0.005  # m: a dragged target farther than this from the curre
 
 
 BLOCKED = "stopped before a singularity of J-bar (a fold of the reachable set): drag the target elsewhere"
+
+
+def orientation_note(model: FsmsModel) -> str:
+    """How many rotational DOF the RNS leaves beyond the hand's position (shown on the panel)."""
+    free = model.n - len(model.selected) - len(model.task_rows)
+    if len(model.task_rows) < 3:
+        return "orientation: not offered (a planar task)"
+    dim = model.n - len(model.selected)
+    if free <= 0:
+        return f"orientation: not offered (n − r = {dim} ≤ 3: the hand's position takes every RNS direction)"
+    least = "" if free >= 3 else ", tracked by least squares"
+    return f"orientation: {min(free, 3)} of 3 rotational DOF free (n − r = {dim}){least}"
 
 
 class InputRefused(ValueError):
@@ -159,13 +174,43 @@ class Operator:
             )
         return self.table
 
-    def drag(self, point: np.ndarray, final: bool = True) -> bool:
+    @property
+    def orienting(self) -> bool:
+        """The reference also tracks the target's orientation (spatial models with n - r >= 4)."""
+        return isinstance(getattr(self, "rr", None), ResolvedRate) and self.rr.orienting
+
+    def law_task(self, kind: str) -> TaskSample | None:
+        """The task sample the laws follow: none on a path; none for (15)/(16) while the orientation is tracked
+        (they then track the pose-carrying theta_ref inside the RNS, as the velocity law (30) does)."""
+        return None if self.on_path or (self.orienting and kind != "velocity") else self.task
+
+    def orientation_view(self) -> OrientationView | None:
+        """The orientation target as the panel and the handle show it (spatial tracking only)."""
+        rr = None if self.on_path else self.rr
+        if not isinstance(rr, ResolvedRate) or len(rr.rows) != 3:
+            return None
+        q = pin.Quaternion(rr.goal_R)
+        wxyz = (float(q.w), float(q.x), float(q.y), float(q.z))
+        return OrientationView(rr.orient_dof > 0, rr.orienting, orientation_note(self.model), wxyz)
+
+    def set_orientation(self, on: bool) -> str:
+        """Track the target's orientation or not; what to tell the operator."""
+        rr = self.rr if not self.on_path else None
+        if not isinstance(rr, ResolvedRate) or rr.orient_dof == 0:
+            raise InputRefused(orientation_note(self.model))
+        rr.set_orientation(on)
+        return orientation_note(self.model) if on else "orientation not tracked: the hand turns as Eq. (24) lets it"
+
+    def drag(self, point: np.ndarray, final: bool = True, wxyz: tuple[float, ...] | None = None) -> bool:
         """Send the arm toward a target (x, y) in the base frame; True if the target had to be moved
-        (onto the current reactionless path, or into the reactionless reachable set).
+        (onto the current reactionless path, or into the reactionless reachable set). ``wxyz``: the goal
+        orientation (base frame), followed when the orientation is tracked.
 
         ``final`` is False while the operator still holds the handle (it is then never moved under them).
         """
         point = np.asarray(point, dtype=float)
+        if wxyz is not None and self.orienting:
+            self.rr.set_goal_rotation(pin.Quaternion(*(float(v) for v in wxyz)).toRotationMatrix())
         self.dragging = not final
         self.target_raw = self._point(point)
         if self.on_path:  # 1-D RNS: the nearest point of the current reactionless path

@@ -9,7 +9,7 @@ import numpy as np
 from rns_viz.live.dual import compensator_sigmas, is_dual
 from rns_viz.live.records import Readouts
 from rns_viz.model import FsmsModel
-from rns_viz.rns import null_vector, rns_projector
+from rns_viz.rns import null_vector, rns_projector, truncated_inverse
 
 
 def arm_reach(model: FsmsModel) -> float:
@@ -27,9 +27,10 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
     m = model.m
     H = model.mass_matrix(model.q(theta))[model.selected, m:]
     rns_dim = model.n - H.shape[0]
-    s_j = np.linalg.svd(model.ee_jacobian(theta) @ rns_projector(H), compute_uv=False)
-    k = min(len(model.task_rows), rns_dim)
-    return H, float(np.linalg.svd(H, compute_uv=False)[-1]), float(s_j[k - 1]) if k >= 1 else float("nan"), rns_dim
+    # the (n - r)-th singular value when the RNS has fewer directions than task rows: the truncation the
+    # reference and Eq. (24) invert with (rns.truncated_inverse), so every readout of sigma(J-bar) agrees
+    s_j = truncated_inverse(model.ee_jacobian(theta) @ rns_projector(H), rns_dim, 1e-12).sigma_min
+    return H, float(np.linalg.svd(H, compute_uv=False)[-1]), s_j if rns_dim >= 1 else float("nan"), rns_dim
 
 
 def null_motion(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -51,6 +51,16 @@ class Settings:
 
 
 @dataclass(frozen=True)
+class OrientationView:
+    """The orientation target of a spatial model's reactionless tracking (what the panel and handle show)."""
+
+    offered: bool  # n - r >= 4: the RNS has directions beyond the hand's position
+    on: bool  # the reference tracks the goal orientation (secondary task)
+    note: str  # how many rotational DOF are free, or why none
+    wxyz: tuple[float, float, float, float]  # the goal orientation, base frame (unit quaternion)
+
+
+@dataclass(frozen=True)
 class Readouts:
     sigma_hbm: float = math.nan  # kg m: smallest singular value of S H_bm
     sigma_jbar: float = math.nan  # m/rad: the RNS-rank-th singular value of J-bar = J P_RNS
@@ -129,6 +139,7 @@ class Snapshot:
     overlay_version: int = 0
     lesson: LessonStatus | None = None
     replay: ReplayView | None = None  # a replay is shown instead of the (paused) live simulation
+    orientation: OrientationView | None = None  # spatial tracking: the orientation target
 
 
 @dataclass(frozen=True)

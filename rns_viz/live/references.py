@@ -6,9 +6,10 @@ immutable samples of them to both runs' laws, so the shadow sees the same operat
 - :class:`SigmaMotion`: sigma = integral of u-bar dt (Eq. 30) held, driven to a goal (scrub, drag),
   by a quintic (Fig. 11) or cyclically (Fig. 12).
 - :class:`PathFollower`: theta_ref on the reactionless path, d theta / d sigma = n(theta) by RK4.
-- :class:`ResolvedRate`: the planar 3R's reactionless resolved-rate reference,
+- :class:`ResolvedRate`: the reactionless resolved-rate reference of a multi-dimensional RNS,
   theta_ref' = J-bar(theta_ref)^+ (x_f' + k (x_f - x(theta_ref))) with a damped inverse, x_f the
-  smoothed target.
+  smoothed target (Eq. 24's J-bar = J P_RNS); in space, optionally an orientation target as a
+  secondary task in the RNS directions that leave the position still (task priority).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from rns_viz.live.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic
-from rns_viz.rns import DampedInverse, damped_pinv, null_vector, rns_projector
+from rns_viz.rns import DampedInverse, null_vector, rns_projector, svd_inverse, truncated_inverse
 
 
 class SigmaMotion:
@@ -197,6 +198,11 @@ class ResolvedRate(SmoothedTarget):
     1 kHz controller as base vibration.
     """
 
+    # rad/s: the orientation is done once its joint rate falls below this. By least squares (fewer than three
+    # rotations free) it creeps toward the best reachable orientation at ~3/s, not k: stopping here leaves
+    # ~ 1e-3 / 3 rad (0.02 deg) and ends the motion about 1 s after the position arrived
+    TURN_TOL = 1e-3
+
     def __init__(
         self,
         model: FsmsModel,
@@ -216,12 +222,41 @@ class ResolvedRate(SmoothedTarget):
         self.leash = leash  # m: the smoothed target waits when it gets this far ahead of the reference
         self.stop_sigma = stop_sigma  # m/rad: no motion that lowers sigma_min(J-bar) below this
         self.joint_speed = joint_speed  # rad/s: |theta_ref'| at most
+        # rotational DOF the RNS leaves beyond the position rows (spatial models): 0 to 3
+        self.orient_dof = max(0, min(3, model.n - len(model.selected) - len(self.rows))) if len(self.rows) == 3 else 0
+        self.orienting = self.orient_dof > 0  # track the goal orientation (secondary task)
+        self.omega_max = 1.0  # rad/s: the orientation error's commanded rate at most
+        self.goal_R = np.eye(3)  # goal orientation of the end effector, base frame
+        self._still = np.zeros(model.n)  # rad/s, never written to
+        self.theta_dot_o = self._still  # rad/s: the secondary (orientation) part of theta_ref'
         self.reset(theta)
 
     def reset(self, theta: np.ndarray, keep_goal: bool = False) -> None:
         super().reset(theta, keep_goal)
+        if not keep_goal:
+            self.goal_R = self.ee_rotation(self.theta)
         self._steps = 0
         self._next: np.ndarray | None = None
+
+    def ee_rotation(self, theta: np.ndarray) -> np.ndarray:
+        """The end effector's orientation in the base frame at ``theta``."""
+        pm, data, m = self.model.pin_model, self.data, self.model.m
+        pin.forwardKinematics(pm, data, np.concatenate([np.zeros(m), theta]))
+        pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
+        return data.oMi[self.model.base_joint_id].rotation.T @ data.oMf[self.model.ee_frame_id].rotation
+
+    def set_orientation(self, on: bool) -> None:
+        """Track the goal orientation or not; switched on, the goal is the present orientation (no jump)."""
+        if on and self.orient_dof == 0:
+            raise ValueError("no RNS directions are left beyond the position: orientation cannot be tracked")
+        self.orienting = bool(on)
+        self.goal_R = self.ee_rotation(self.theta)
+
+    def set_goal_rotation(self, R: np.ndarray) -> None:
+        """The goal orientation (a rotation matrix, base frame); followed while :attr:`orienting`."""
+        self.goal_R = np.array(R, dtype=float)
+        if self.orienting:
+            self.idle = False
 
     def _projector(self, q: np.ndarray) -> np.ndarray:
         """P_RNS at q, from S H_bm."""
@@ -235,17 +270,29 @@ class ResolvedRate(SmoothedTarget):
         J = (data.oMi[self.model.base_joint_id].rotation.T @ J_world)[self.rows]
         return self._inverse(J @ self._projector(q)).sigma_min
 
+    def _toward_fold(self, thetadot: np.ndarray) -> bool:
+        """Close to a singular curve of J-bar (sigma_min below ``stop_sigma``) and ``thetadot`` goes closer."""
+        return self.sigma_jbar < self.stop_sigma and self._sigma_at(self.theta + 0.05 * thetadot) < self.sigma_jbar
+
     def _inverse(self, J_bar: np.ndarray) -> DampedInverse:
         """J-bar^+, damped below ``threshold``. With fewer RNS directions than task rows (boom7, r = 5: a 2-D
         RNS, a 3-D target) J-bar has rank n - r at most: it is inverted on its range (the hand moves toward
         the target's projection on the reachable surface) and sigma_min is its (n - r)-th singular value."""
-        k = self.model.n - len(self.model.selected)
-        if J_bar.shape[0] <= k:
-            return damped_pinv(J_bar, self.threshold, self.threshold)
-        U, s, Vt = np.linalg.svd(J_bar, full_matrices=False)
-        U, s, Vt = U[:, :k], s[:k], Vt[:k]
-        lam2 = (1.0 - (s[-1] / self.threshold) ** 2) * self.threshold**2 if s[-1] < self.threshold else 0.0
-        return DampedInverse(Vt.T @ np.diag(s / (s**2 + lam2)) @ U.T, float(s[-1]), float(np.sqrt(lam2)))
+        return truncated_inverse(J_bar, self.model.n - len(self.model.selected), self.threshold)
+
+    def orientation_rate(
+        self, V: np.ndarray, P: np.ndarray, J_o: np.ndarray, R: np.ndarray, thetadot_p: np.ndarray
+    ) -> np.ndarray:
+        """The secondary task: N (J_o N)^+ (w - J_o theta_p'), N = P - V^T V = P - J-bar^+ J-bar (the RNS
+        directions that leave the hand's position still; V: J-bar's right singular vectors of its nonzero
+        singular values), w = k log3(R_d R^T) limited to ``omega_max``; least squares when N has fewer
+        than 3 directions (``orient_dof``)."""
+        N = P - V.T @ V
+        w = self.k * pin.log3(self.goal_R @ R.T)
+        w_norm = float(np.sqrt(w @ w))
+        if w_norm > self.omega_max:
+            w *= self.omega_max / w_norm
+        return N @ (truncated_inverse(J_o @ N, self.orient_dof, self.threshold).inverse @ (w - J_o @ thetadot_p))
 
     def ee(self, theta: np.ndarray) -> np.ndarray:
         pm, data, m = self.model.pin_model, self.data, self.model.m
@@ -271,7 +318,8 @@ class ResolvedRate(SmoothedTarget):
         at_goal = f.step(self.goal, dt, tol=1e-6)
         pm, data, m = self.model.pin_model, self.data, self.model.m
         q = np.concatenate([np.zeros(m), self.theta])
-        J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
+        J_six = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:, m:]
+        J_world = J_six[:3]
         pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
         base = data.oMi[self.model.base_joint_id]
         J = (base.rotation.T @ J_world)[self.rows]
@@ -283,24 +331,37 @@ class ResolvedRate(SmoothedTarget):
             f.v = np.zeros_like(f.v)
             at_goal = False
         P = self._projector(q)
-        inverse = self._inverse(J @ P)
+        J_bar = J @ P
+        rank = min(len(self.rows), self.model.n - len(self.model.selected))
+        svd = np.linalg.svd(J_bar, full_matrices=False) if self.orienting else None  # one SVD for both tasks
+        inverse = self._inverse(J_bar) if svd is None else svd_inverse(*svd, rank, self.threshold)
         self.sigma_jbar = inverse.sigma_min
         thetadot = P @ (inverse.inverse @ (f.v + self.k * (f.x - x)))
         speed = float(np.sqrt(thetadot @ thetadot))
         if speed > self.joint_speed:
             thetadot *= self.joint_speed / speed
-        self.blocked = (
-            self.sigma_jbar < self.stop_sigma and self._sigma_at(self.theta + 0.05 * thetadot) < self.sigma_jbar
-        )
+        self.theta_dot_o = self._still
+        if self.orienting:  # orthogonal to the primary part: it gets the joint speed the position leaves
+            R = base.rotation.T @ data.oMf[self.model.ee_frame_id].rotation
+            th_o = self.orientation_rate(svd[2][:rank], P, base.rotation.T @ J_six[3:], R, thetadot)  # type: ignore[index]
+            room = float(np.sqrt(max(0.0, self.joint_speed**2 - float(thetadot @ thetadot))))
+            speed_o = float(np.sqrt(th_o @ th_o))
+            self.theta_dot_o = th_o * (room / speed_o) if speed_o > room else th_o
+            thetadot = thetadot + self.theta_dot_o
+        if self.orienting and self._toward_fold(thetadot):  # the turn would lead into a fold: not from here
+            thetadot, self.theta_dot_o = thetadot - self.theta_dot_o, self._still
+        self.blocked = self._toward_fold(thetadot)
         if self.blocked:  # the way to the target crosses a singular curve of J-bar: stop before it
             thetadot = np.zeros_like(thetadot)
+            self.theta_dot_o = self._still
             f.x, f.v = x.copy(), np.zeros_like(f.v)
             at_goal = False
         xdot = J @ thetadot
         self.xddot = (xdot - self.xdot) / dt
         self.x, self.xdot, self.thetadot = x, xdot, thetadot
         self._next = self.theta + thetadot * dt
-        if at_goal and float(np.abs(f.x - x).max()) < 1e-6:
+        turning = self.orienting and float(np.sqrt(self.theta_dot_o @ self.theta_dot_o)) > self.TURN_TOL
+        if at_goal and float(np.abs(f.x - x).max()) < 1e-6 and not turning:
             self.idle, self._next = True, None
             self.thetadot = np.zeros_like(thetadot)
             self.xdot = np.zeros_like(xdot)

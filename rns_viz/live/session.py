@@ -22,6 +22,7 @@ import time
 import traceback
 from collections import deque
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -170,10 +171,16 @@ class Session:
     def set_shadow(self, on: bool, client: int | None = None) -> None:
         self.send(c.SetShadow(on, client=client))
 
-    def set_target(self, xy: tuple[float, ...] | np.ndarray, final: bool = False, client: int | None = None) -> None:
+    def set_target(
+        self, xy: tuple[float, ...] | np.ndarray, final: bool = False, client: int | None = None, wxyz: Any = None
+    ) -> None:
         """Drag the end-effector target to (x, y) (planar) or (x, y, z) in the base frame, m; ``final`` at the
-        end of a drag."""
-        self.send(c.DragTarget(xy, final, client=client))  # type: ignore[arg-type]
+        end of a drag; ``wxyz`` the goal orientation of a pose handle (base frame)."""
+        self.send(c.DragTarget(xy, final, wxyz, client=client))  # type: ignore[arg-type]
+
+    def track_orientation(self, on: bool, client: int | None = None) -> None:
+        """Spatial models: the end effector also follows the target's orientation (n - r >= 4)."""
+        self.send(c.TrackOrientation(on, client=client))
 
     def scrub(self, sigma: float, client: int | None = None) -> None:
         """Move the reference along the current reactionless path to sigma (1/(kg m))."""

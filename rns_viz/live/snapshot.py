@@ -46,6 +46,7 @@ def make_snapshot(
         mode="paused" if paused and not diverged else mode,
         target=None if target is None else target.copy(),
         target_version=target_version,
+        orientation=op.orientation_view() if op is not None else None,
         sigma=op.sigma if op is not None else None,
         sigma_range=None
         if table is None

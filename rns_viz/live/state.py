@@ -52,8 +52,7 @@ class LiveState:
         self.settings = Settings.defaults(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
         self.lesson: LessonRun | None = None
-        self.kicks_sent = 0  # kicks since the session started (lessons count them)
-        self.targets_moved = 0  # dragged targets moved onto the path / into the set (lessons count them)
+        self.kicks_sent = self.targets_moved = 0  # kicks, dragged targets moved onto the path / into the set
         self._preset_paused = False  # the preset being built starts paused
         self.start_live(model)
 
@@ -98,7 +97,7 @@ class LiveState:
     def _install_live_laws(self) -> None:
         op = self.operator
         assert op is not None
-        self.runs.install(self._choice(), op.joint, op.task if not op.on_path else None, op.joint_move is not None)
+        self.runs.install(self._choice(), op.joint, op.law_task(self.settings.law), op.joint_move is not None)
 
     def _restart_bookkeeping(self) -> None:
         self.epoch += 1
@@ -237,8 +236,11 @@ class LiveState:
                 if on and not st.shadow:
                     self.runs.resync_shadow()
                 self.settings = replace(st, shadow=on)
-            case c.DragTarget(xy=xy, final=final):
-                self._drag(np.array(xy), final, cmd.client)
+            case c.DragTarget(xy=xy, final=final, wxyz=wxyz):
+                self._drag(np.array(xy), final, cmd.client, wxyz)
+            case c.TrackOrientation(on=on):
+                self.notify("Orientation", self._go_live().set_orientation(on), cmd.client, "info")
+                self._install_live_laws()  # (15)/(16) follow theta_ref while the orientation is tracked
             case c.Scrub(sigma=sigma):
                 self._go_live().scrub(sigma)
                 self.target_version += 1
@@ -275,9 +277,8 @@ class LiveState:
             case _:
                 raise TypeError(f"unknown command {cmd!r}")
 
-    def _drag(self, xy: np.ndarray, final: bool, client: int | None) -> None:
-        op = self._go_live()
-        moved = op.drag(xy, final)
+    def _drag(self, xy: np.ndarray, final: bool, client: int | None, wxyz: tuple[float, ...] | None) -> None:
+        moved = (op := self._go_live()).drag(xy, final, wxyz)
         if final:
             self.targets_moved += int(moved)
             self.target_version += 1

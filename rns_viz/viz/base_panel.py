@@ -1,6 +1,7 @@
 """The panel of a base with several coordinates (boom7: x, y, z, rx, ry, rz): the kick's direction,
 the selection S (which reactions must vanish, Sec. III-B) with the reaction null space's dimension
-n - r, and a live plot of every base coordinate. Hidden for a 1-DOF base.
+n - r, whether the handle's orientation is tracked too (n - r >= 4: rotational DOF left over), and a
+live plot of every base coordinate. Hidden for a 1-DOF base.
 
 The checkboxes make one typed command (:class:`~rns_viz.live.commands.SetSelection`) the loop
 applies; what the loop refuses (an RNS the app does not operate) comes back as a notice and the
@@ -46,6 +47,13 @@ class BasePanel:
             gui.add_markdown("**Selection S**: tick the base reactions that must vanish (Eq. 8).")
             self.boxes = [gui.add_checkbox(f"S{i + 1}", True) for i in range(BASE_COORDINATES)]
             self.rns = gui.add_markdown("")
+            self.orientation = gui.add_checkbox(
+                "track orientation",
+                False,
+                hint="The hand also turns to the handle's orientation (rotation rings), in the RNS directions the "
+                "position leaves free (n − r ≥ 4): all three rotations for n − r ≥ 6, fewer by least squares.",
+            )
+            self.orientation_note = gui.add_markdown("")
             self.involution = gui.add_markdown("")  # the Lie-bracket test of the RNS distribution (Sec. III-A)
             self.plot = gui.add_uplot(
                 data=tuple(np.zeros(2) for _ in range(BASE_COORDINATES + 1)),
@@ -66,6 +74,7 @@ class BasePanel:
         controls.on_input(self.direction, lambda v, c: None)  # read at the next kick
         for box in self.boxes:
             controls.on_input(box, lambda v, c: controls.session.set_selection(self._flags(), c))
+        controls.on_input(self.orientation, lambda v, c: controls.session.track_orientation(bool(v), c))
         controls.kick_direction = self.kick_direction
 
     def _flags(self) -> tuple[bool, ...]:
@@ -114,6 +123,12 @@ class BasePanel:
             else f"a {n - r}-D reaction null space: drag the handle in 3-D, the hand tracks it by Eq. (24)"
         )
         self.rns.content = f"r = {r} of {model.m}; n − r = {n} − {r} = **{n - r}**: {what}."
+        view = snap.orientation
+        self.orientation.visible = self.orientation_note.visible = view is not None
+        if view is not None:
+            self.controls.show(self.orientation, view.on)
+            self.orientation.disabled = not view.offered
+            self.orientation_note.content = view.note
 
     def update(self, arrays: dict[str, np.ndarray], version: int) -> None:
         """Send the base coordinates of the operated run (plot buffers in mm / mrad), and the integrability

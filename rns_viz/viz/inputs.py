@@ -53,6 +53,7 @@ class Controls:
         self.kick_direction: Callable[[], tuple[float, ...] | None] = lambda: None
         self.spatial_target = False  # the handle gives (x, y, z), not (x, y): set by the renderer per model
         self.target_lift = np.zeros(3)  # m: the handle is drawn this far above the target (base frame)
+        self.pose_target = False  # the handle's orientation is the target's too (set by the renderer)
         self._wire()
 
     # ---------------------------------------------------------------- values shown vs. values in force
@@ -199,7 +200,7 @@ class Controls:
             xy = (position - self.target_lift)[:3] if self.spatial_target else position[:2]
             if xy.shape != ((3,) if self.spatial_target else (2,)) or not np.all(np.isfinite(position)):
                 raise ValueError(f"the target must be finite coordinates, got {position}")
-            self.session.set_target(xy, end, cid)
+            self.session.set_target(xy, end, cid, event.target.wxyz if self.pose_target else None)
         except ValueError as exc:
             self._handle_home_requested = True
             self.connections.notify(client, "Target not applied", str(exc), "warning")

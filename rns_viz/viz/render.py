@@ -207,11 +207,14 @@ class Renderer:
     def _draw_target(self, snap: Snapshot) -> None:
         """The handle back home when the target moved (or a drag was refused), and the target marker."""
         seen = self._seen
-        if snap.target_version != seen.target_version:
-            seen.target_version = snap.target_version
+        pose = snap.orientation is not None and snap.orientation.on  # a pose handle: rotation rings too
+        if snap.target_version != seen.target_version or pose != seen.pose:
+            seen.target_version, seen.pose = snap.target_version, pose
             home = self._home(snap)
             if np.all(np.isfinite(home)):
                 self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
+            self.handle.disable_rotations, self.controls.pose_target = not pose, pose
+            self.handle.wxyz = snap.orientation.wxyz if pose else (1.0, 0.0, 0.0, 0.0)  # type: ignore[union-attr]
         target = None if snap.target is None else tuple(np.round(snap.target, 6))
         if target is not None and not np.all(np.isfinite(target)):
             target = seen.target  # never draw a non-finite target
@@ -342,6 +345,7 @@ class _Seen:
         self.exaggeration = float("nan")
         self.overlay_version = -1
         self.target_version = -1
+        self.pose = False  # the handle shows rotation rings (the orientation is tracked)
         self.target: tuple[float, ...] | None = ()
         self.settings_version = -1
         self.plot_version: object = -1
