@@ -141,7 +141,7 @@ def test_the_rotational_dof_offered_follow_n_minus_r(r: int, free: int) -> None:
     flags = tuple(i < r for i in range(6))
     model = boom(flags)
     rr = ResolvedRate(model, model.spec.default_configuration)
-    assert rr.orient_dof == free and rr.orienting == (free > 0)
+    assert rr.orient_dof == free and rr.orienting == (free == 3)  # on by default for the whole pose only
     note = orientation_note(model)
     if free:
         assert f"{free} of 3 rotational DOF free (n − r = {7 - r})" in note

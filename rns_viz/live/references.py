@@ -224,7 +224,9 @@ class ResolvedRate(SmoothedTarget):
         self.joint_speed = joint_speed  # rad/s: |theta_ref'| at most
         # rotational DOF the RNS leaves beyond the position rows (spatial models): 0 to 3
         self.orient_dof = max(0, min(3, model.n - len(model.selected) - len(self.rows))) if len(self.rows) == 3 else 0
-        self.orienting = self.orient_dof > 0  # track the goal orientation (secondary task)
+        # Track the goal orientation (secondary task) by default only where all of it can be held (r <= 1):
+        # with fewer rotational DOF it is opt-in, so forces-only tracking stays the paper's Eq. (24).
+        self.orienting = self.orient_dof == 3
         self.omega_max = 1.0  # rad/s: the orientation error's commanded rate at most
         self.goal_R = np.eye(3)  # goal orientation of the end effector, base frame
         self._still = np.zeros(model.n)  # rad/s, never written to
