@@ -35,7 +35,7 @@ import numpy as np
 MODELS = ("trep", "planar3r", "arm7", "boom7")
 
 
-def worker(steps: int, arm7_toml: str) -> None:
+def worker(steps: int, arm7_toml: str, models: tuple[str, ...]) -> None:
     """Serve rounds: for each line on stdin, time ``steps`` Python steps per model with the rns_viz found on
     sys.path (a fresh simulator each round) and print µs/step (wall, CPU) and the final state as one JSON line."""
     import numpy as np
@@ -45,7 +45,7 @@ def worker(steps: int, arm7_toml: str) -> None:
     from rns_viz.sim import Simulator
 
     starts = {}
-    for name in MODELS:
+    for name in models:
         model = FsmsModel.from_file(arm7_toml) if name == "arm7" else FsmsModel.from_name(name)
         v0 = np.zeros(model.nv)
         v0[0] = 0.01
@@ -56,12 +56,12 @@ def worker(steps: int, arm7_toml: str) -> None:
         law = AccelerationLaw(model, Gains(g_b=10.0, g_m=1.0))
         return Simulator(model, law, q0=q0, v0=v0, log_capacity=steps + 1, native=False)
 
-    for name in MODELS:
+    for name in models:
         simulator(name).run(0.3)  # warm-up
     print("ready", flush=True)
     for _ in sys.stdin:
         result = {}
-        for name in MODELS:
+        for name in models:
             sim = simulator(name)
             step = sim.step
             t0, c0 = time.perf_counter(), time.process_time()
@@ -75,12 +75,12 @@ def worker(steps: int, arm7_toml: str) -> None:
 class Worker:
     """A subprocess running :func:`worker` with ``tree`` first on its path; :meth:`round` times one round."""
 
-    def __init__(self, tree: Path, steps: int, arm7_toml: Path) -> None:
+    def __init__(self, tree: Path, steps: int, arm7_toml: Path, models: tuple[str, ...]) -> None:
         env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}  # leave the other tree as it is
         command = [sys.executable, str(Path(__file__).resolve()), str(tree), "--worker", str(arm7_toml)]
         self.tree = tree
         self.process = subprocess.Popen(
-            [*command, "--steps", str(steps)],
+            [*command, "--steps", str(steps), "--models", ",".join(models)],
             cwd=tree,
             env=env,
             stdin=subprocess.PIPE,
@@ -110,10 +110,14 @@ def main() -> None:
     parser.add_argument("other", type=Path, help="root of the other checkout of rns_viz")
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--steps", type=int, default=3000, help="timed steps per model and round")
+    parser.add_argument("--models", default=",".join(MODELS), help="comma-separated; an older checkout may lack boom7")
     parser.add_argument("--worker", metavar="ARM7_TOML", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    models = tuple(args.models.split(","))
+    if unknown := set(models) - set(MODELS):
+        parser.error(f"unknown models {sorted(unknown)}; choose from {', '.join(MODELS)}")
     if args.worker:
-        worker(args.steps, args.worker)
+        worker(args.steps, args.worker, models)
         return
 
     here = Path(__file__).resolve().parent.parent
@@ -122,13 +126,13 @@ def main() -> None:
 
     trees = {"this": here, "other": args.other.resolve()}
     clocks = ("wall", "cpu")
-    times = {(tree, clock): {name: [] for name in MODELS} for tree in trees for clock in clocks}
+    times = {(tree, clock): {name: [] for name in models} for tree in trees for clock in clocks}
     states: dict[tuple[str, str], np.ndarray] = {}  # the state (q, v) after the last round's steps
     load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "arm7.urdf").write_text(arm7_urdf())
         (Path(tmp) / "arm7.toml").write_text(ARM7_TOML)
-        workers = {tree: Worker(path, args.steps, Path(tmp) / "arm7.toml") for tree, path in trees.items()}
+        workers = {tree: Worker(path, args.steps, Path(tmp) / "arm7.toml", models) for tree, path in trees.items()}
         for r in range(args.rounds):
             order = list(trees) if r % 2 == 0 else list(reversed(trees))
             for tree in order:
@@ -145,7 +149,7 @@ def main() -> None:
     print(f"load average (1, 5, 15 min) before, after: {load}")
     header = ("model", "clock", "this min", "median", "other min", "median", "ratio min", "median")
     print("{:<10}{:<6}{:>10}{:>9}{:>11}{:>9}{:>11}{:>9}".format(*header))
-    for name in MODELS:
+    for name in models:
         for clock in clocks:
             a, b = times["this", clock][name], times["other", clock][name]
             med_a, med_b = statistics.median(a), statistics.median(b)
@@ -154,7 +158,7 @@ def main() -> None:
                 f"{min(a) / min(b):>11.3f}{med_a / med_b:>9.3f}"
             )
     print("µs per step; ratio = this / other (below 1: this tree is faster)")
-    for name in MODELS:
+    for name in models:
         a, b = states["this", name], states["other", name]
         rel = np.max(np.abs(a - b)) / np.max(np.abs(b))
         print(f"{name:<10}final state, max |this - other| / max |other|: {rel:.1e}")

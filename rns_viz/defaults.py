@@ -54,6 +54,10 @@ class ModelDefaults:
 
 
 FALLBACK_GAINS = Gains(g_b=10.0, g_m=1.0)
+# m: a kick about a rotational base coordinate is the moment of the kick's force at this lever arm
+# (boom7: the slider's 20 N give 2 N m). A moment equal to the force in N would be a lever of 1 m, and
+# 5 N m about the boom's z axis asks the suppressing arm to spin at over 100 rad/s (the run stops).
+KICK_LEVER_M = 0.1
 
 MODEL_DEFAULTS: dict[str, ModelDefaults] = {
     "trep": ModelDefaults(

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import viser
 
+from rns_viz.defaults import KICK_LEVER_M
 from rns_viz.live.plots import BASE_COORDINATES
 from rns_viz.live.records import Snapshot
 from rns_viz.model import FsmsModel
@@ -23,14 +24,21 @@ COLOURS = ("#1f6fd1", "#e0503a", "#2a9d4b", "#8e44ad", "#c77700", "#555555")
 ALL = "all together"
 
 
+def rotational_coordinates(model: FsmsModel) -> list[bool]:
+    """Which base coordinates are rotations (a revolute base joint)."""
+    return [model.pin_model.joints[i + 1].shortname().startswith("JointModelR") for i in range(model.m)]
+
+
 def coordinate_names(model: FsmsModel) -> list[str]:
     """Short names of the base coordinates ("base_rx" -> "rx") with units."""
-    names = []
-    for i, joint in enumerate(model.spec.base.joints):
-        short = joint.removeprefix("base_")
-        turns = model.pin_model.joints[i + 1].shortname().startswith("JointModelR")
-        names.append(f"{short} ({'mrad' if turns else 'mm'})")
-    return names
+    joints, turns = model.spec.base.joints, rotational_coordinates(model)
+    return [f"{j.removeprefix('base_')} ({'mrad' if t else 'mm'})" for j, t in zip(joints, turns, strict=True)]
+
+
+def kick_weights(turns: list[bool], index: int | None) -> tuple[float, ...]:
+    """The kick's weights over the base coordinates: along coordinate ``index`` (None: all of them), 1 on a
+    translation (the kick's force, N) and KICK_LEVER_M on a rotation (its moment at that lever, N m per N)."""
+    return tuple((KICK_LEVER_M if t else 1.0) if index is None or i == index else 0.0 for i, t in enumerate(turns))
 
 
 class BasePanel:
@@ -41,8 +49,9 @@ class BasePanel:
             self.direction = gui.add_dropdown(
                 "Kick along",
                 ("x",),
-                hint="The kick pushes along this base coordinate (N; N m on a rotation), or along all of them "
-                "at once. Along the boom's axis (x) it is very stiff: a sideways kick (y, z) shows the suppression.",
+                hint="The kick pushes along this base coordinate, or along all of them at once; about a rotation "
+                f"it is the moment of the kick's force at {KICK_LEVER_M:g} m (N m). Along the boom's axis (x) it is "
+                "very stiff: a sideways kick (y, z) shows the suppression.",
             )
             gui.add_markdown("**Selection S**: tick the base reactions that must vanish (Eq. 8).")
             self.boxes = [gui.add_checkbox(f"S{i + 1}", True) for i in range(BASE_COORDINATES)]
@@ -69,6 +78,7 @@ class BasePanel:
                 aspect=2.1,
             )
         self.m = 1
+        self.turns: list[bool] = [False]
         self.plot_version = -1
         self.overlay_version = -1
         controls.on_input(self.direction, lambda v, c: None)  # read at the next kick
@@ -87,13 +97,13 @@ class BasePanel:
         choice = self.controls.good(self.direction)
         options = list(self.direction.options)
         if choice == ALL:
-            return (1.0,) * self.m
-        index = options.index(choice) if choice in options else 1
-        return tuple(1.0 if i == index else 0.0 for i in range(self.m))
+            return kick_weights(self.turns, None)
+        return kick_weights(self.turns, options.index(choice) if choice in options else 1)
 
     def for_model(self, model: FsmsModel, default_axis: int = 1) -> None:
         """Show the panel for ``model`` (hidden for a 1-DOF base)."""
         self.m = model.m
+        self.turns = rotational_coordinates(model)
         self.folder.visible = model.m > 1
         if model.m == 1:
             return
