@@ -126,11 +126,13 @@ class BasePanel:
             self.controls.show(box, bool(flag))
         r = sum(flags)
         n = model.n
+        turning = snap.orientation is not None and snap.orientation.on
         what = (
             "a 1-D reaction null space: the arm moves without reaction only along its reactionless path "
             "(scrub ū or drag the handle)"
             if n - r == 1
-            else f"a {n - r}-D reaction null space: drag the handle in 3-D, the hand tracks it by Eq. (24)"
+            else f"a {n - r}-D reaction null space: drag the handle in 3-D, the hand tracks it "
+            + ("and its orientation in the RNS (task priority)" if turning else "by Eq. (24)")
         )
         self.rns.content = f"r = {r} of {model.m}; n − r = {n} − {r} = **{n - r}**: {what}."
         view = snap.orientation
