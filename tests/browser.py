@@ -161,9 +161,11 @@ def screenshot(page: Page, name: str) -> Path:
     return path
 
 
-@pytest.fixture(params=["trep", "planar3r"], name="app")
+@pytest.fixture(params=["trep", pytest.param("planar3r", marks=pytest.mark.docs)], name="app")
 def each_model_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
-    """The app of each bundled planar model on a free port (import this fixture into a test module)."""
+    """The app of each bundled planar model on a free port (import this fixture into a test module). The 3R's
+    pass over the same page is on demand (``-m docs``, with its screenshots): the default run drives the 3R's
+    page in the lesson, scene and plots browser tests and its app through the protocol (tests/test_app.py)."""
     app = start_app(request.param, port=0, verbose=False)
     yield app
     app.stop()

@@ -107,11 +107,20 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         wait_until(
             lambda: np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - hand0) > 0.01, 20.0, "the arm to follow"
         )
-        wait_until(lambda: not s.state.operator.busy, 30.0, "the arm to arrive")  # type: ignore[union-attr]
-        snap = s.snapshot()
-        assert np.linalg.norm(model.ee_position(snap.q[6:]) - snap.target) < 3e-3
+
+        def gap() -> float:
+            snap = s.snapshot()
+            return float(np.linalg.norm(model.ee_position(snap.q[6:]) - snap.target))
+
+        # within 3 mm of the target (the reference's own idle test asks 1e-6 m, which its periodic projection
+        # onto the reactionless manifold may keep it from declaring on a busy machine)
+        try:
+            wait_until(lambda: gap() < 3e-3, 60.0, "the arm to arrive")
+        except AssertionError as e:
+            rr = s.state.operator.rr  # type: ignore[union-attr]
+            raise AssertionError(f"{e}: {gap() * 1e3:.1f} mm from the target, blocked at a fold: {rr.blocked}") from e
         L = np.stack([s.state.runs.sim.log.column(f"L_{i}", last=3000) for i in (1, 2, 3)])
-        assert np.abs(L).max() < 1e-2 * model.arm_mass * snap.settings.target_speed  # kg m/s
+        assert np.abs(L).max() < 1e-2 * model.arm_mass * s.snapshot().settings.target_speed  # kg m/s
         app.scene.set_initial_camera()
         page.mouse.move(5, 5)
         dismiss_notifications(page)
