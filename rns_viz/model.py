@@ -94,6 +94,9 @@ class FsmsModel:
         self.base_is_translational = all(
             model.joints[i].shortname().startswith("JointModelP") for i in range(1, self.m + 1)
         )
+        # per base coordinate: a rotation (a revolute base joint: rad, N m) or not
+        joints = model.joints
+        self.base_rotational = tuple(joints[i].shortname().startswith("JointModelR") for i in range(1, self.m + 1))
         # c_b = H_bm' theta' exactly (M does not depend on x_b): see dynamics()
         self.cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
         # ee_kinematics: its buffers, the task rows as a slice where they are contiguous, and

@@ -9,29 +9,29 @@ import pytest
 
 from rns_viz.defaults import KICK_LEVER_M, defaults_for
 from rns_viz.live.session import Session
-from rns_viz.viz.base_panel import kick_weights, rotational_coordinates
+from rns_viz.viz.base_panel import kick_weights
 
 PEAK_N = defaults_for("boom7").kick_range_N  # the slider's end (20 N)
 
 
 @pytest.fixture(scope="module")
-def turns() -> list[bool]:
+def turns() -> tuple[bool, ...]:
     s = Session("boom7", realtime=False)
     try:
-        return rotational_coordinates(s.state.model)
+        return s.state.model.base_rotational
     finally:
         s.stop()
 
 
-def test_the_weights_are_the_force_on_translations_and_its_moment_on_rotations(turns: list[bool]) -> None:
-    assert turns == [False, False, False, True, True, True]  # x y z, then rx ry rz
+def test_the_weights_are_the_force_on_translations_and_its_moment_on_rotations(turns: tuple[bool, ...]) -> None:
+    assert turns == (False, False, False, True, True, True)  # x y z, then rx ry rz
     assert kick_weights(turns, None) == (1.0, 1.0, 1.0, KICK_LEVER_M, KICK_LEVER_M, KICK_LEVER_M)
     assert kick_weights(turns, 1) == (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)
     assert kick_weights(turns, 5) == (0.0, 0.0, 0.0, 0.0, 0.0, KICK_LEVER_M)
 
 
 @pytest.mark.parametrize("index", [0, 1, 2, 3, 4, 5, None], ids=["x", "y", "z", "rx", "ry", "rz", "all"])
-def test_every_offered_direction_at_the_largest_peak_is_suppressed(turns: list[bool], index: int | None) -> None:
+def test_every_offered_direction_at_the_largest_peak_is_suppressed(turns: tuple[bool, ...], index: int | None) -> None:
     s = Session("boom7", realtime=False)
     try:
         s.advance(0.05)

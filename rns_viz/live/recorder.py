@@ -211,11 +211,10 @@ class Recording:
         return [f"{name} ({column_unit(name, self._rotational(name))})" for name in self.columns]
 
     def _rotational(self, name: str) -> bool:
-        """A base column about a rotation: a rotational 1-DOF base, or rows 4-6 of a 6-DOF one (x y z rx ry rz)."""
-        if self.model.m == 6:
-            prefix, _, row = name.removeprefix("shadow_").rpartition("_")
-            return prefix in ("xb", "xbdot", "fext", "reaction") and row in ("4", "5", "6")
-        return not self.model.base_is_translational
+        """A base column about a rotation (its base row's joint is revolute; a row-less name: the first row's)."""
+        row = name.rpartition("_")[2]
+        i = int(row) - 1 if row.isdigit() and 0 < int(row) <= self.model.m else 0
+        return self.model.base_rotational[i]
 
     def wrench(self, k: int) -> tuple[float, ...]:
         """The recorded reaction's base rows at step k (N, N m); () before the first evaluation."""

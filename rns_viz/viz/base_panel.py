@@ -24,18 +24,13 @@ COLOURS = ("#1f6fd1", "#e0503a", "#2a9d4b", "#8e44ad", "#c77700", "#555555")
 ALL = "all together"
 
 
-def rotational_coordinates(model: FsmsModel) -> list[bool]:
-    """Which base coordinates are rotations (a revolute base joint)."""
-    return [model.pin_model.joints[i + 1].shortname().startswith("JointModelR") for i in range(model.m)]
-
-
 def coordinate_names(model: FsmsModel) -> list[str]:
     """Short names of the base coordinates ("base_rx" -> "rx") with units."""
-    joints, turns = model.spec.base.joints, rotational_coordinates(model)
+    joints, turns = model.spec.base.joints, model.base_rotational
     return [f"{j.removeprefix('base_')} ({'mrad' if t else 'mm'})" for j, t in zip(joints, turns, strict=True)]
 
 
-def kick_weights(turns: list[bool], index: int | None) -> tuple[float, ...]:
+def kick_weights(turns: tuple[bool, ...], index: int | None) -> tuple[float, ...]:
     """The kick's weights over the base coordinates: along coordinate ``index`` (None: all of them), 1 on a
     translation (the kick's force, N) and KICK_LEVER_M on a rotation (its moment at that lever, N m per N)."""
     return tuple((KICK_LEVER_M if t else 1.0) if index is None or i == index else 0.0 for i, t in enumerate(turns))
@@ -78,7 +73,7 @@ class BasePanel:
                 aspect=2.1,
             )
         self.m = 1
-        self.turns: list[bool] = [False]
+        self.turns: tuple[bool, ...] = (False,)
         self.plot_version = -1
         self.overlay_version = -1
         controls.on_input(self.direction, lambda v, c: None)  # read at the next kick
@@ -103,7 +98,7 @@ class BasePanel:
     def for_model(self, model: FsmsModel, default_axis: int = 1) -> None:
         """Show the panel for ``model`` (hidden for a 1-DOF base)."""
         self.m = model.m
-        self.turns = rotational_coordinates(model)
+        self.turns = model.base_rotational
         self.folder.visible = model.m > 1
         if model.m == 1:
             return
