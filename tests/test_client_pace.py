@@ -193,6 +193,29 @@ def test_a_slow_client_gets_fewer_updates_a_fast_one_all_and_a_frozen_one_none(t
     assert np.isfinite(app.session.snapshot().t)
 
 
+def test_a_page_with_nothing_new_to_show_is_asked_nothing() -> None:
+    """Every question makes viser's page draw 3-D frames (a question is not a GUI-only message), so a
+    page whose stream is quiet is not asked: a paused app's page draws nothing. Once the scene moves,
+    the questions (and the pacing) come back."""
+    app = start_app("trep", port=0, realtime=False, verbose=False)  # moves only when the test steps it
+    client = ProtocolClient(app.port, decode=True, watch_node="/base/link1")
+    try:
+        wait_for_clients(app, 1, "a client")
+        page = app.pace.pages[client_id(app, set())]
+        wait_until(lambda: page.answered_once, 10.0, "the first answer")
+        time.sleep(1.0)  # the first scene and panel have gone out
+        asked = client.answers
+        time.sleep(1.5)  # six question gaps (PING_GAP_S) with nothing sent
+        assert client.answers == asked, "a page with nothing new to show was asked"
+        app.session.kick(5.0)
+        app.session.advance(0.5)  # the arm and base move: new poses go out
+        wait_until(lambda: client.answers > asked, 10.0, "a question once the stream moved")
+        assert app.pace.state(page.client.client_id)["hz"] == FULL_HZ  # a page that keeps up
+    finally:
+        client.close()
+        app.stop()
+
+
 def test_pacing_switched_off_sends_every_client_everything() -> None:
     app = start_app("trep", port=0, verbose=False, pace=False)
     slow = ProtocolClient(app.port, decode=True, answer_delay_s=1.0)

@@ -9,7 +9,11 @@ page, not in TCP.
 The signal: a round trip through the page's own message queue. Every client is asked, about four
 times a second, for a localStorage value (viser's public ``client.local_storage.get_item``). The
 page answers only after it has applied every message that arrived before the question, so the
-answer time measures how far it is behind (tens of ms for a page that keeps up).
+answer time measures how far it is behind (tens of ms for a page that keeps up). A question is
+asked only while there is something to keep up with: the broadcast stream sent the page a window since
+the last answer, or the page is still paced or told so. viser's page draws a burst of 3-D frames for
+every message that is not GUI-only, a question included, so a page with nothing new to show is left
+alone: a paused app's page draws no frames (software WebGL at 4 questions a second drew ~17 a second).
 :class:`~rns_viz.viz.pace_control.PaceController` turns answer times into a rate per client.
 
 The means: the scene, the plots and the text are broadcast (``server.scene`` / ``server.gui``),
@@ -42,7 +46,7 @@ from typing import Any
 
 import viser
 
-from rns_viz.viz.pace_control import PaceController
+from rns_viz.viz.pace_control import FULL_HZ, PaceController
 
 PING_KEY = "rns_viz_pace"  # the localStorage key asked for (its value does not matter)
 PING_GAP_S = 0.25  # s between an answer and the next question
@@ -76,6 +80,7 @@ class PagePace:
         self._notice: viser.GuiHtmlHandle | None = None  # the slowed-display line, once shown
         self._notice_hz = 0
         self._notice_time = 0.0
+        self._stream_moved = threading.Event()  # set when the broadcast stream sends this page a window
         self.thread = threading.Thread(target=self._run, name=f"rns-pace-{client.client_id}", daemon=True)
 
     def start(self) -> None:
@@ -83,6 +88,10 @@ class PagePace:
 
     def stop(self) -> None:
         self._stop.set()
+
+    def window_sent(self) -> None:
+        """The broadcast stream just sent this page a window (called from the gate)."""
+        self._stream_moved.set()
 
     def wait_s(self, since_last_send_s: float) -> float:
         """How long the client's broadcast stream should wait before its next window."""
@@ -106,8 +115,21 @@ class PagePace:
         finally:
             self.answered_once = False  # a page nobody asks any more is never held
 
+    def _question_due(self) -> bool:
+        """Whether the page has something to keep up with: it has never answered, the stream sent it
+        a window since the last question, or it is still paced or told that it is slowed."""
+        if not self.answered_once or self._stream_moved.is_set():
+            return True
+        with self._lock:
+            return self.control.hz < FULL_HZ or self.control.noticed
+
     def _ask_once(self) -> None:
-        """One question, its answer timed into the controller; the notice brought up to date."""
+        """One question (once one is due), its answer timed into the controller; the notice brought up
+        to date."""
+        while not self._question_due():
+            if self._stop.wait(GATE_POLL_S) or not self._is_connected(self.client.client_id):
+                return
+        self._stream_moved.clear()  # windows from now on are for the next question
         with self._lock:
             self.control.ping_sent(time.monotonic())
         try:  # no time limit: a frozen tab answers when it thaws, and until then it is held
@@ -160,7 +182,7 @@ class ClientPace:
         self.server = server
         self.notice_order = notice_order  # panel order of each client's slowed-display line
         self.pages: dict[int, PagePace] = {}
-        self.enabled = enabled and install_gate(server, self._wait_s)
+        self.enabled = enabled and install_gate(server, self._wait_s, self._window_sent)
 
     def client_joined(self, client: viser.ClientHandle) -> None:
         if not self.enabled:
@@ -186,10 +208,18 @@ class ClientPace:
         page = self.pages.get(client_id)
         return 0.0 if page is None else page.wait_s(since_last_send_s)
 
+    def _window_sent(self, client_id: int) -> None:
+        page = self.pages.get(client_id)
+        if page is not None:
+            page.window_sent()
 
-def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float]) -> bool:
+
+def install_gate(
+    server: viser.ViserServer, wait_s: Callable[[int, float], float], sent: Callable[[int], None] = lambda _: None
+) -> bool:
     """Make each client's reader of the broadcast buffer wait ``wait_s(client, s since its last
-    window)`` before taking its next window. False (with a warning) if this viser has no such buffer."""
+    window)`` before taking its next window, and call ``sent(client)`` for each window it takes. False
+    (with a warning) if this viser has no such buffer."""
     try:
         buffer = server._websock_server._broadcast_buffer  # type: ignore[attr-defined]
         original = buffer.window_generator
@@ -199,7 +229,7 @@ def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float
 
     def window_generator(client_id: int, backlog_done_message: Any = None) -> AsyncGenerator[Sequence[Any], None]:
         windows = original(client_id, backlog_done_message=backlog_done_message)
-        return _paced(windows, client_id, wait_s, buffer.max_window_size)
+        return _paced(windows, client_id, wait_s, buffer.max_window_size, sent)
 
     buffer.window_generator = window_generator
     return True
@@ -210,6 +240,7 @@ async def _paced(
     client_id: int,
     wait_s: Callable[[int, float], float],
     max_window: int,
+    sent: Callable[[int], None] = lambda _: None,
 ) -> AsyncGenerator[Sequence[Any], None]:
     """viser's windows for one client, each taken only once the gate opens. While this waits, viser's
     buffer keeps only the newest message per node and property, so the next window is the latest state.
@@ -225,6 +256,7 @@ async def _paced(
             except StopAsyncIteration:
                 return
             last_sent, window_size = time.monotonic(), len(window)
+            sent(client_id)
             yield window
     finally:
         await windows.aclose()
