@@ -32,8 +32,24 @@ CHROMIUM_FLAGS = [
     "--disable-component-update",
     "--disable-sync",
 ]
+# Chromium's switch for tests that need no pixels: WebGL calls run (three.js builds and updates its scene
+# graph, raycasts, uploads buffers), but the GPU process rasterises nothing. Software WebGL drew a frame
+# of the app in ~0.3 s of CPU at 1280x800, so a page drawing its scene held most of a core while a test
+# ran. Pages whose pixels a test reads or saves for people to look at draw: ``draw=True``, and every page
+# while pictures are made (RNS_VIZ_SCREENSHOTS, or RNS_VIZ_DRAW=1 for artifacts/ too).
+NO_DRAWING = "--disable-gl-drawing-for-tests"
 ARTIFACTS = Path(__file__).resolve().parent.parent / "artifacts"
 SKIP_REASON = f"real-browser test needs Debian chromium at {CHROMIUM} (apt-get install chromium)"
+
+
+def pictures_wanted() -> bool:
+    """Whether every page draws its scene (screenshots for the docs, or asked for)."""
+    return "RNS_VIZ_SCREENSHOTS" in os.environ or os.environ.get("RNS_VIZ_DRAW") == "1"
+
+
+def chromium_flags(draw: bool = False) -> list[str]:
+    """The flags of a test's chromium: it draws its 3-D scene only if ``draw`` or pictures are wanted."""
+    return CHROMIUM_FLAGS if draw or pictures_wanted() else [*CHROMIUM_FLAGS, NO_DRAWING]
 
 
 def chromium_available() -> bool:
@@ -80,14 +96,15 @@ def local_server() -> Iterator[viser.ViserServer]:
 
 @contextmanager
 def browser_page(
-    server: viser.ViserServer, width: int = 1280, height: int = 800, timeout: float = 30.0
+    server: viser.ViserServer, width: int = 1280, height: int = 800, timeout: float = 30.0, draw: bool = False
 ) -> Iterator[Page]:
-    """A Playwright page showing ``server``, yielded once the client has connected.
+    """A Playwright page showing ``server``, yielded once the client has connected; its 3-D scene is
+    drawn only if ``draw`` (or pictures are wanted, :func:`pictures_wanted`).
 
     ``chromium.launch`` gives every browser a fresh temporary profile (user-data-dir) of its own.
     """
     with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(draw), headless=True)
         try:
             page = browser.new_page(viewport={"width": width, "height": height})
             page.goto(f"http://127.0.0.1:{server.get_port()}/", timeout=timeout * 1000)

@@ -47,8 +47,12 @@ def app() -> Iterator[RnsApp]:
     app.stop()
 
 
+DRAG_STEP_S = 0.1  # s between the drag's ten mouse moves: a hand's pace (a whole drag in about a second)
+
+
 def drag_handle_along_x(page: Page, app: RnsApp, pixels: float) -> None:
-    """Press on the handle's x arrow (30 % of its length out), move ``pixels`` along it, release."""
+    """Press on the handle's x arrow (30 % of its length out), move ``pixels`` along it in about a second
+    (not at the pace of the page's frames, which depends on how fast the machine draws), release."""
     x0, y0 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.3 * app.handle.scale])
     x1, y1 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.6 * app.handle.scale])
     d = np.array([x1 - x0, y1 - y0]) / max(float(np.hypot(x1 - x0, y1 - y0)), 1e-9)
@@ -57,6 +61,7 @@ def drag_handle_along_x(page: Page, app: RnsApp, pixels: float) -> None:
     for k in range(1, 11):
         page.mouse.move(x0 + d[0] * pixels * k / 10, y0 + d[1] * pixels * k / 10)
         wait_for_frames(page, 2)
+        page.wait_for_timeout(1000 * DRAG_STEP_S)
     page.mouse.up()
 
 

@@ -64,7 +64,7 @@ def test_scene_renders_in_chromium(name: str) -> None:
         scene.update(model.q(theta0, [x_b]), gain)
         scene.set_reaction_force(FORCE[name])
 
-        with browser_page(server) as page:
+        with browser_page(server, draw=True) as page:  # its pixels are read
             nodes = {FsmsScene.BASE, "/base/link1", overlay, base_drawing, FsmsScene.FORCE, FsmsScene.TRAIL}
             wait_for_nodes(page, nodes)
             rest = np.asarray(model.pin_model.jointPlacements[1].translation)

@@ -120,7 +120,11 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
             rr = s.state.operator.rr  # type: ignore[union-attr]
             raise AssertionError(f"{e}: {gap() * 1e3:.1f} mm from the target, blocked at a fold: {rr.blocked}") from e
         L = np.stack([s.state.runs.sim.log.column(f"L_{i}", last=3000) for i in (1, 2, 3)])
-        assert np.abs(L).max() < 1e-2 * model.arm_mass * s.snapshot().settings.target_speed  # kg m/s
+        # kg m/s. What is left is the arm lagging its reactionless reference each time the target starts and
+        # stops: a mouse drag is ten small moves, so it depends on how the page spaces them (0.05-0.12 measured
+        # with pages of different speeds; the bound is 0.25). One programmed move keeps under 1 % of the
+        # arm's momentum scale headless (0.036 kg m/s, tests/test_live_spatial.py).
+        assert np.abs(L).max() < 3e-2 * model.arm_mass * s.snapshot().settings.target_speed
         app.scene.set_initial_camera()
         page.mouse.move(5, 5)
         dismiss_notifications(page)

@@ -28,9 +28,9 @@ from rns_viz.viz.teach_scene import TeachScene
 from tests.browser import (
     ARTIFACTS,
     CHROMIUM,
-    CHROMIUM_FLAGS,
     browser_marks,
     browser_page,
+    chromium_flags,
     dismiss_notifications,
     local_position,
     screenshot,
@@ -123,7 +123,7 @@ def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
     threading.Thread(target=httpd.serve_forever, daemon=True).start()
     try:
         with sync_playwright() as pw:
-            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS, headless=True)
+            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(), headless=True)
             try:
                 page = browser.new_page(viewport={"width": 1280, "height": 800})
                 page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}", timeout=60_000)
