@@ -57,10 +57,13 @@ class Worker:
             return self._cv.wait_for(lambda: not self._pending and not self._busy, timeout)
 
     def stop(self) -> None:
+        """Take no more jobs. A job in flight (a call into the helper process, up to a second or two for
+        boom7's geometry) is not waited for: the thread is a daemon that ends when the call returns, and
+        its result is dropped. (Waiting cost every stopped session that long.)"""
         with self._cv:
             self._stop = True
             self._cv.notify_all()
-        self._thread.join(timeout=5.0)
+        self._thread.join(timeout=0.05)
 
     def _run(self) -> None:
         while True:
