@@ -9,6 +9,7 @@ import pytest
 
 from rns_viz.defaults import KICK_LEVER_M, defaults_for
 from rns_viz.live.session import Session
+from rns_viz.model import FsmsModel
 from rns_viz.viz.base_panel import kick_weights
 
 PEAK_N = defaults_for("boom7").kick_range_N  # the slider's end (20 N)
@@ -16,11 +17,7 @@ PEAK_N = defaults_for("boom7").kick_range_N  # the slider's end (20 N)
 
 @pytest.fixture(scope="module")
 def turns() -> tuple[bool, ...]:
-    s = Session("boom7", realtime=False)
-    try:
-        return s.state.model.base_rotational
-    finally:
-        s.stop()
+    return FsmsModel.from_key("boom7").base_rotational
 
 
 def test_the_weights_are_the_force_on_translations_and_its_moment_on_rotations(turns: tuple[bool, ...]) -> None:

@@ -174,7 +174,10 @@ def _serve() -> None:
             reply = (True, JOBS[name](*args))
         except Exception as exc:
             reply = (False, f"{name}: {type(exc).__name__}: {exc}")
-        _write(stdout, reply)
+        try:
+            _write(stdout, reply)
+        except BrokenPipeError:  # the caller's process ended while this job ran: nobody wants the result
+            return
 
 
 if __name__ == "__main__":

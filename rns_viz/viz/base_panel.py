@@ -72,8 +72,7 @@ class BasePanel:
                 cursor={"show": False},
                 aspect=2.1,
             )
-        self.m = 1
-        self.turns: tuple[bool, ...] = (False,)
+        self.turns: tuple[bool, ...] = (False,)  # per base coordinate: a rotation (model.base_rotational)
         self.plot_version = -1
         self.overlay_version = -1
         controls.on_input(self.direction, lambda v, c: None)  # read at the next kick
@@ -95,9 +94,13 @@ class BasePanel:
             return kick_weights(self.turns, None)
         return kick_weights(self.turns, options.index(choice) if choice in options else 1)
 
+    @property
+    def m(self) -> int:
+        """The shown model's base coordinates."""
+        return len(self.turns)
+
     def for_model(self, model: FsmsModel, default_axis: int = 1) -> None:
         """Show the panel for ``model`` (hidden for a 1-DOF base)."""
-        self.m = model.m
         self.turns = model.base_rotational
         self.folder.visible = model.m > 1
         if model.m == 1:

@@ -126,9 +126,10 @@ class PagePace:
     def _ask_once(self) -> None:
         """One question (once one is due), its answer timed into the controller; the notice brought up
         to date."""
-        while not self._question_due():
-            if self._stop.wait(GATE_POLL_S) or not self._is_connected(self.client.client_id):
+        while not self._question_due():  # only a window from the stream can make it due here
+            if self._stop.is_set() or not self._is_connected(self.client.client_id):
                 return
+            self._stream_moved.wait(GATE_POLL_S)
         self._stream_moved.clear()  # windows from now on are for the next question
         with self._lock:
             self.control.ping_sent(time.monotonic())
@@ -214,9 +215,7 @@ class ClientPace:
             page.window_sent()
 
 
-def install_gate(
-    server: viser.ViserServer, wait_s: Callable[[int, float], float], sent: Callable[[int], None] = lambda _: None
-) -> bool:
+def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float], sent: Callable[[int], None]) -> bool:
     """Make each client's reader of the broadcast buffer wait ``wait_s(client, s since its last
     window)`` before taking its next window, and call ``sent(client)`` for each window it takes. False
     (with a warning) if this viser has no such buffer."""
