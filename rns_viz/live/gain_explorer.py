@@ -181,6 +181,7 @@ class GainExplorer:
         return self.worker.has_results()
 
     def stop(self) -> None:
+        self._key = None  # a sweep in flight goes stale: it stops at its next call into the helper
         self.worker.stop()
 
     def _publish(self, **changes: object) -> None:
