@@ -23,6 +23,7 @@ import struct
 import subprocess
 import sys
 import threading
+from collections import OrderedDict
 from typing import IO, Any
 
 import numpy as np
@@ -74,6 +75,7 @@ def linear_loops(name: str, law: LawKind, thetas: np.ndarray) -> list[LinearLoop
 
 
 JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region, linear_loop, loop_and_map, linear_loops)}
+CACHE_BYTES = 64 * 2**20  # the helper's reply cache (ReplyCache); the largest reply, boom7's gain map, is 1.8 MB
 BACKGROUND_JOBS = frozenset({"linear_loop", "loop_and_map", "linear_loops"})  # the gain explorer's: they yield
 
 
@@ -88,11 +90,15 @@ def _write(stream: IO[bytes], obj: Any) -> None:
 
 
 def _read(stream: IO[bytes]) -> Any:
+    return pickle.loads(_read_bytes(stream))
+
+
+def _read_bytes(stream: IO[bytes]) -> bytes:
     header = stream.read(8)
     if len(header) < 8:
         raise EOFError("the job helper closed its pipe")
     (size,) = struct.unpack("<Q", header)
-    return pickle.loads(stream.read(size))
+    return stream.read(size)
 
 
 class _Helper:
@@ -161,24 +167,67 @@ def call(name: str, *args: Any) -> Any:
     return _helper.call(name, *args)
 
 
-def _serve() -> None:
-    """The helper's loop: read a job, run it, write (ok, result or error text); stop at end of input."""
-    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
-    sys.stdout = sys.stderr  # a stray print must not corrupt the pipe
+class ReplyCache:
+    """The last replies by request bytes, at most ``budget`` bytes of them (least recently used leave first).
+
+    Every job is a function of its arguments and the model file, so a request seen before is answered
+    from here: a reset, a lesson restarted or a model switched back gets its path table, reachable set
+    and gain map at once instead of in seconds (a planar 3R's reachable set: ~1 s).
+    """
+
+    def __init__(self, budget: int = CACHE_BYTES) -> None:
+        self.budget = budget
+        self._replies: OrderedDict[bytes, bytes] = OrderedDict()
+        self._size = 0
+
+    def get(self, request: bytes) -> bytes | None:
+        reply = self._replies.get(request)
+        if reply is not None:
+            self._replies.move_to_end(request)
+        return reply
+
+    def put(self, request: bytes, reply: bytes) -> None:
+        if request in self._replies or len(request) + len(reply) > self.budget:
+            return
+        self._replies[request] = reply
+        self._size += len(request) + len(reply)
+        while self._size > self.budget:
+            old, old_reply = self._replies.popitem(last=False)
+            self._size -= len(old) + len(old_reply)
+
+
+def _answer(request: bytes) -> tuple[bytes, bool]:
+    """The pickled reply to one pickled request, and whether it may be cached (failures are not)."""
+    name, args = pickle.loads(request)
+    try:
+        reply: tuple[bool, Any] = (True, JOBS[name](*args))
+    except Exception as exc:
+        reply = (False, f"{name}: {type(exc).__name__}: {exc}")
+    return pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL), reply[0]
+
+
+def serve(stdin: IO[bytes], stdout: IO[bytes]) -> None:
+    """The helper's loop: read a job, run it (or find its reply in the cache), write (ok, result or error
+    text); stop at end of input."""
+    cache = ReplyCache()
     while True:
         try:
-            name, args = _read(stdin)
+            request = _read_bytes(stdin)
         except EOFError:
             return
+        reply = cache.get(request)
+        if reply is None:
+            reply, ok = _answer(request)
+            if ok:
+                cache.put(request, reply)
         try:
-            reply = (True, JOBS[name](*args))
-        except Exception as exc:
-            reply = (False, f"{name}: {type(exc).__name__}: {exc}")
-        try:
-            _write(stdout, reply)
+            stdout.write(struct.pack("<Q", len(reply)) + reply)
+            stdout.flush()
         except BrokenPipeError:  # the caller's process ended while this job ran: nobody wants the result
             return
 
 
 if __name__ == "__main__":
-    _serve()
+    out = sys.stdout.buffer
+    sys.stdout = sys.stderr  # a stray print must not corrupt the pipe
+    serve(sys.stdin.buffer, out)
