@@ -238,8 +238,13 @@ def test_hostile_replay_values_are_set_back_and_the_server_lives(trep_app: RnsAp
         ws.set_value(gui_uuid(app.replay.seconds), -5.0)
         time.sleep(1.0)
         wait_until(lambda: app.replay.speed.value == 1.0, 5.0, "the speed to be set back")
-        assert s.pending_commands() == []  # nothing queued from the hostile values
-        assert s.snapshot().replay is not None and s.snapshot().replay.speed == 1.0
+        # Nothing hostile is queued. viser's callback reads the slider when it runs, so on a loaded machine
+        # the render thread may have shown the playhead again first: a seek to it is queued (harmless).
+        replay = s.snapshot().replay
+        assert replay is not None and replay.speed == 1.0
+        t0, t1 = replay.recording.span
+        queued = list(s._commands)
+        assert all(isinstance(cmd, c.SeekReplay) and t0 - 0.01 <= cmd.t <= t1 + 0.01 for cmd in queued), queued
         assert app.render_thread.is_alive()
         ws.click(gui_uuid(app.replay.live))
         wait_until(lambda: s.pending_commands() == ["StopReplay"], 5.0, "back to live")
