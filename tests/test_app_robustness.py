@@ -17,12 +17,13 @@ from tests.protocol_client import ProtocolClient
 def test_invalid_gain_input_is_refused_and_the_old_value_kept(trep_app: RnsApp, client: ProtocolClient) -> None:
     s, slider = trep_app.session, trep_app.gui.gains["g_b"]
     old = s.snapshot().settings.gains.g_b
-    for bad in (float("nan"), -5.0, float("inf")):
+    for told, bad in enumerate((float("nan"), -5.0, float("inf")), start=1):
         client.set_value(uuid(slider), bad)
+        # The refusal is told first (the slider shows the old value even before the server read the input).
+        wait_until(lambda n=told: client.types["NotificationShowMessage"] >= n, 10.0, f"the refusal of {bad} told")
         wait_until(lambda old=old: slider.value == old, 10.0, f"g_b to return to {old} after {bad}")
         s.advance(0.01)
         assert s.snapshot().settings.gains.g_b == old
-    wait_until(lambda: client.types["NotificationShowMessage"] >= 3, 10.0, "one notification per refusal")
     with pytest.raises(InvalidGain):
         s.set_gains(g_m=-1.0)
     client.set_value(uuid(slider), 12.0)  # a good value is applied
