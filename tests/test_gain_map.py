@@ -130,9 +130,10 @@ def _kick_rate(
 
 # 3 x 3 subsets of the default 60 x 60 grid where the base swings often enough for the peak fit (at
 # least three half periods in the simulated time): rows (g_b), columns (g_m), duration s, kick N, and
-# when the fit starts, s. (5 x 5 of the same ranges measured the same: within 10 % everywhere.) TREP: g_b 1.2-19, g_m 6.6-54 /s (the paper's 24, 20 among them). The 3R:
-# g_b 0.4-3.3, g_m 6.6-110 /s, its base swinging at 1.3-1.8 rad/s; its fit starts at 1 s, once the
-# real root of the cubic near -G_m (a large share of x_b, no swing) has died out.
+# when the fit starts, s (5 x 5 over the same ranges all measured within 10 % too). TREP: g_b 1.2-19,
+# g_m 6.6-54 /s (the paper's 24, 20 among them). The 3R: g_b 0.4-3.3, g_m 6.6-110 /s, its base swinging
+# at 1.3-1.8 rad/s; its fit starts at 1 s, once the real root of the cubic near -G_m (a large share of
+# x_b, no swing) has died out.
 SUBSETS = {
     ("trep", "velocity"): ((14, 22, 30), (24, 30, 36), 3.0, 0.05, 0.2),
     ("planar3r", "acceleration"): ((8, 14, 20), (24, 32, 40), 7.0, 0.5, 1.0),
