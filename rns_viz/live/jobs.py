@@ -12,7 +12,9 @@ to every other job: a caller of those waits while one of the others waits, so a 
 for after a change of S waits for at most the one explorer call in flight (the explorer cuts its
 sweep over a path into calls of a few configurations, rns_viz.live.gain_explorer).
 
-Jobs are the top-level functions below: plain arguments, picklable results.
+Jobs are the top-level functions below: plain arguments, picklable results. Each is a function of its
+arguments (and the model file), so the helper answers a request it has already answered from its
+:class:`ReplyCache`.
 """
 
 from __future__ import annotations
