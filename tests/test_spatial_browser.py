@@ -94,20 +94,30 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         wait_until(lambda: not off().orientation.on and not app.controls.pose_target, 20.0, "the position handle")  # type: ignore[union-attr]
         wait_until(lambda: s.overlays().reach is not None, 60.0, "the reachable set")
         wait_until(lambda: app.scene.reachable.visible, 20.0, "the reachable set drawn")
+        # The new selection is a new model: the server rebuilt the scene (reset, meshes, a new handle), and
+        # showed the reachable set after that. Once the page shows it, the page has the new handle too: the
+        # set may come from the helper's cache at once, and a press while the page rebuilds moves nothing.
+        shown = "(n) => window.__viserMutable?.nodeRefFromName?.[n]?.visible === true"
+        wait_until(lambda: page.evaluate(shown, app.scene.REACHABLE), 60.0, "the page to show the reachable set")
         assert len(s.overlays().reach) > 100 and "involutive" in s.overlays().reach_note  # type: ignore[arg-type]
         wait_until(lambda: "involutive" in app.base_panel.involution.content, 20.0, "the bracket test in the panel")
         model = s.state.model
         hand0 = model.ee_position(s.snapshot().q[6:])
         before = np.array(s.snapshot().target, dtype=float)
         wait_for_frames(page, 10)
+        handle0 = np.array(app.handle.position, dtype=float)
         for attempt in range(3):  # a software-rendered page may miss a press made while it re-lays the panel
             drag_handle_along_x(page, app, 50.0)
             try:
                 wait_until(lambda: np.linalg.norm(s.snapshot().target - before) > 0.01, 10.0, "the target to move")
                 break
-            except AssertionError:
-                if attempt == 2:
-                    raise
+            except AssertionError as e:
+                if attempt == 2:  # say whether the drag reached the server (it moves the handle) and what it said
+                    said = [f"{n.title}: {n.body}" for n in s.pop_notices()]
+                    raise AssertionError(
+                        f"{e}: handle {np.round(app.handle.position, 4)} (was {np.round(handle0, 4)}), target "
+                        f"{np.round(s.snapshot().target, 4)} (was {np.round(before, 4)}), notices {said}"
+                    ) from e
         wait_until(
             lambda: np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - hand0) > 0.01, 20.0, "the arm to follow"
         )
