@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import io
 import pickle
-import struct
 from typing import Any
 
 import numpy as np
@@ -27,10 +26,11 @@ def framed(*requests: tuple[str, tuple[Any, ...]]) -> io.BytesIO:
 def replies(stream: io.BytesIO) -> list[bytes]:
     stream.seek(0)
     found = []
-    while header := stream.read(8):
-        (size,) = struct.unpack("<Q", header)
-        found.append(stream.read(size))
-    return found
+    while True:
+        try:
+            found.append(jobs._read_bytes(stream))
+        except EOFError:
+            return found
 
 
 def test_a_repeated_request_is_computed_once_and_answered_with_the_same_bytes(

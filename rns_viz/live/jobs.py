@@ -86,7 +86,10 @@ class JobError(RuntimeError):
 
 
 def _write(stream: IO[bytes], obj: Any) -> None:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    _write_bytes(stream, pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL))
+
+
+def _write_bytes(stream: IO[bytes], data: bytes) -> None:
     stream.write(struct.pack("<Q", len(data)) + data)
     stream.flush()
 
@@ -223,8 +226,7 @@ def serve(stdin: IO[bytes], stdout: IO[bytes]) -> None:
             if ok:
                 cache.put(request, reply)
         try:
-            stdout.write(struct.pack("<Q", len(reply)) + reply)
-            stdout.flush()
+            _write_bytes(stdout, reply)
         except BrokenPipeError:  # the caller's process ended while this job ran: nobody wants the result
             return
 
