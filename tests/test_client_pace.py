@@ -216,6 +216,44 @@ def test_a_page_with_nothing_new_to_show_is_asked_nothing() -> None:
         app.stop()
 
 
+def test_a_running_app_at_rest_asks_nothing_while_only_the_panel_changes() -> None:
+    """A real-time app whose arms rest still streams its panel (status line, plots: GUI-only messages,
+    which viser's page applies without a 3-D frame). Those windows make no question due, so the page
+    draws no frames for the questions; a kick moves the scene and the questions come back."""
+    app = start_app("trep", port=0, verbose=False)  # real time, at rest
+    client = ProtocolClient(app.port, decode=True, watch_node="/base/link1")
+    try:
+        wait_for_clients(app, 1, "a client")
+        page = app.pace.pages[client_id(app, set())]
+        wait_until(lambda: page.answered_once, 10.0, "the first answer")
+        time.sleep(1.5)  # the first scene and panel have gone out, the last question answered
+        asked, panel, poses = client.answers, sum(client.gui_updates.values()), len(client.pose_times)
+        time.sleep(1.5)  # six question gaps (PING_GAP_S)
+        assert sum(client.gui_updates.values()) > panel + 5, "the running app's panel did not stream"
+        assert len(client.pose_times) == poses, "the resting arm was sent new poses"
+        assert client.answers == asked, "a page with only panel updates was asked"
+        app.session.kick(0.8)
+        wait_until(lambda: client.answers > asked, 10.0, "a question once the scene moved")
+    finally:
+        client.close()
+        app.stop()
+
+
+def test_only_windows_with_scene_messages_touch_the_scene() -> None:
+    """The GUI-only set matches what viser's page applies without a frame: panel values, new controls
+    and notifications are GUI-only; a pose, a scene node or a localStorage question is not."""
+    from viser import _messages as m
+
+    from rns_viz.viz.client_pace import touches_scene
+
+    gui = m.GuiUpdateMessage(uuid="u", updates={"value": 1.0})
+    note = m.RemoveNotificationMessage(uuid="n")
+    pose = m.SetPositionMessage(name="/base", position=(0.0, 0.0, 0.0))
+    ask = m.LocalStorageGetItemRequestMessage(key="k", request_uuid="r")
+    assert not touches_scene([gui, note]) and not touches_scene([])
+    assert touches_scene([gui, pose]) and touches_scene([ask])
+
+
 def test_pacing_switched_off_sends_every_client_everything() -> None:
     app = start_app("trep", port=0, verbose=False, pace=False)
     slow = ProtocolClient(app.port, decode=True, answer_delay_s=1.0)

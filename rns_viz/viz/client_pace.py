@@ -10,10 +10,12 @@ The signal: a round trip through the page's own message queue. Every client is a
 times a second, for a localStorage value (viser's public ``client.local_storage.get_item``). The
 page answers only after it has applied every message that arrived before the question, so the
 answer time measures how far it is behind (tens of ms for a page that keeps up). A question is
-asked only while there is something to keep up with: the broadcast stream sent the page a window since
-the last answer, or the page is still paced or told so. viser's page draws a burst of 3-D frames for
-every message that is not GUI-only, a question included, so a page with nothing new to show is left
-alone: a paused app's page draws no frames (software WebGL at 4 questions a second drew ~17 a second).
+asked only while there is something to keep up with: the broadcast stream sent the page a window that
+touches the 3-D scene since the last answer, or the page is still paced or told so. viser's page draws a
+burst of 3-D frames for every message that is not GUI-only, a question included, and applies GUI-only
+messages at once without a frame, so a page with no new scene to show is left alone: a paused app's page
+draws no frames (software WebGL at 4 questions a second drew ~17 a second), nor does a running app's page
+while the arms rest and only the panel's numbers change (it drew ~9 a second, for the questions alone).
 :class:`~rns_viz.viz.pace_control.PaceController` turns answer times into a rate per client.
 
 The means: the scene, the plots and the text are broadcast (``server.scene`` / ``server.gui``),
@@ -45,6 +47,7 @@ from contextlib import suppress
 from typing import Any
 
 import viser
+import viser._messages as viser_messages
 
 from rns_viz.viz.pace_control import FULL_HZ, PaceController
 
@@ -90,7 +93,8 @@ class PagePace:
         self._stop.set()
 
     def window_sent(self) -> None:
-        """The broadcast stream just sent this page a window (called from the gate)."""
+        """The broadcast stream just sent this page a window that touches the 3-D scene (called from the
+        gate)."""
         self._stream_moved.set()
 
     def wait_s(self, since_last_send_s: float) -> float:
@@ -117,7 +121,7 @@ class PagePace:
 
     def _question_due(self) -> bool:
         """Whether the page has something to keep up with: it has never answered, the stream sent it
-        a window since the last question, or it is still paced or told that it is slowed."""
+        a scene window since the last question, or it is still paced or told that it is slowed."""
         if not self.answered_once or self._stream_moved.is_set():
             return True
         with self._lock:
@@ -215,10 +219,40 @@ class ClientPace:
             page.window_sent()
 
 
+# What viser's page applies without drawing a 3-D frame: its client's GUI-only set (messageQueue.ts in
+# viser 1.1.1), by the Python names of those messages. A name this viser lacks is left out, which only
+# makes a question due more often.
+GUI_ONLY_NAMES = (
+    "_CreateGuiComponentMessage",
+    "GuiUpdateMessage",
+    "GuiRemoveMessage",
+    "GuiModalMessage",
+    "GuiCloseModalMessage",
+    "GuiPanelMessage",
+    "GuiPanelRemoveMessage",
+    "GuiSetPanelCollapsedMessage",
+    "GuiSetPanelHeightMessage",
+    "GuiSetPanelPositionMessage",
+    "GuiSetPanelWidthMessage",
+    "SetGuiPanelLabelMessage",
+    "NotificationShowMessage",
+    "NotificationUpdateMessage",
+    "RemoveNotificationMessage",
+)
+GUI_ONLY: tuple[type, ...] = tuple(
+    kind for name in GUI_ONLY_NAMES if isinstance(kind := getattr(viser_messages, name, None), type)
+)
+
+
+def touches_scene(window: Sequence[Any]) -> bool:
+    """Whether a window of messages makes viser's page draw 3-D frames (any message not GUI-only)."""
+    return not all(isinstance(message, GUI_ONLY) for message in window)
+
+
 def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float], sent: Callable[[int], None]) -> bool:
     """Make each client's reader of the broadcast buffer wait ``wait_s(client, s since its last
-    window)`` before taking its next window, and call ``sent(client)`` for each window it takes. False
-    (with a warning) if this viser has no such buffer."""
+    window)`` before taking its next window, and call ``sent(client)`` for each window it takes that
+    touches the 3-D scene. False (with a warning) if this viser has no such buffer."""
     try:
         buffer = server._websock_server._broadcast_buffer  # type: ignore[attr-defined]
         original = buffer.window_generator
@@ -255,7 +289,8 @@ async def _paced(
             except StopAsyncIteration:
                 return
             last_sent, window_size = time.monotonic(), len(window)
-            sent(client_id)
+            if touches_scene(window):
+                sent(client_id)
             yield window
     finally:
         await windows.aclose()
