@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import time
+import weakref
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -16,7 +17,6 @@ from typing import Any
 
 import pytest
 import viser
-from playwright.sync_api import Error as PlaywrightError
 from playwright.sync_api import Page, sync_playwright
 
 from rns_viz.viz.app import RnsApp, start_app
@@ -40,6 +40,9 @@ CHROMIUM_FLAGS = [
 NO_DRAWING = "--disable-gl-drawing-for-tests"
 ARTIFACTS = Path(__file__).resolve().parent.parent / "artifacts"
 SKIP_REASON = f"real-browser test needs Debian chromium at {CHROMIUM} (apt-get install chromium)"
+
+
+_DRAWING_PAGES: weakref.WeakSet[Page] = weakref.WeakSet()  # the pages opened with draw=True
 
 
 def pictures_wanted() -> bool:
@@ -107,6 +110,8 @@ def browser_page(
         browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(draw), headless=True)
         try:
             page = browser.new_page(viewport={"width": width, "height": height})
+            if draw:
+                _DRAWING_PAGES.add(page)
             page.goto(f"http://127.0.0.1:{server.get_port()}/", timeout=timeout * 1000)
             wait_until(lambda: len(server.get_clients()) > 0, timeout, "the browser to connect to viser")
             yield page
@@ -134,13 +139,10 @@ def local_position(page: Page, name: str) -> list[float] | None:
 
 
 def dismiss_notifications(page: Page) -> None:
-    """Close the client's toasts (e.g. "Software WebGL rendering detected") before a screenshot."""
-    buttons = page.locator(".mantine-Notification-closeButton")
-    for k in reversed(range(buttons.count())):
-        try:  # a toast may close itself (or be replaced) while we reach for it: then it is gone anyway
-            buttons.nth(k).click(timeout=2000)
-        except PlaywrightError:
-            continue
+    """Close the client's toasts (e.g. "Software WebGL rendering detected") before a screenshot: a click
+    on each close button in one call (a software-rendered page answers each Playwright action only after
+    its next frame, so one locator click per toast took ~1 s)."""
+    page.evaluate("() => document.querySelectorAll('.mantine-Notification-closeButton').forEach((b) => b.click())")
 
 
 def wait_for_nodes(page: Page, names: set[str], timeout: float = 30.0) -> None:
@@ -168,6 +170,13 @@ def wait_for_frames(page: Page, frames: int = 30) -> None:
         })""",
         frames,
     )
+
+
+def settle_for_picture(page: Page, frames: int) -> None:
+    """Before a screenshot: ``frames`` animation frames on a page that draws its scene (``draw=True``, or
+    pictures wanted), so the picture shows it settled; 2 on a page that draws no pixels, whose picture
+    shows the panel, which the page has laid out by then (each software-rendered frame takes ~0.2 s)."""
+    wait_for_frames(page, frames if page in _DRAWING_PAGES or pictures_wanted() else 2)
 
 
 def screenshot(page: Page, name: str) -> Path:

@@ -16,7 +16,7 @@ from tests.browser import (
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
     screenshot,
-    wait_for_frames,
+    settle_for_picture,
     wait_for_nodes,
     wait_until,
 )
@@ -86,6 +86,6 @@ def test_operate_the_app_in_chromium(app: RnsApp) -> None:
         page.mouse.move(5, 5)  # no tooltip over the panel
         page.get_by_text("Operate", exact=True).scroll_into_view_if_needed()
         dismiss_notifications(page)
-        wait_for_frames(page, 30)
+        settle_for_picture(page, 30)
         path = screenshot(page, f"app_{name}")
         assert path.stat().st_size > 10_000

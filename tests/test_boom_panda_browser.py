@@ -19,7 +19,7 @@ from tests.browser import (
     browser_page,
     dismiss_notifications,
     screenshot,
-    wait_for_frames,
+    settle_for_picture,
     wait_for_nodes,
     wait_until,
 )
@@ -54,5 +54,5 @@ def test_boom_panda_in_chromium_shows_the_meshes_and_suppresses_a_kick(panda_app
         page.get_by_text("Operate", exact=True).scroll_into_view_if_needed()
         for _ in range(2):  # a software-rendered page may raise its WebGL toast late
             dismiss_notifications(page)
-            wait_for_frames(page, 30)
+            settle_for_picture(page, 30)
         assert screenshot(page, "app_boom_panda").stat().st_size > 10_000

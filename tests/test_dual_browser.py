@@ -18,6 +18,7 @@ from tests.browser import (
     browser_page,
     dismiss_notifications,
     screenshot,
+    settle_for_picture,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
@@ -91,5 +92,5 @@ def test_drag_the_task_arm_in_chromium(app: RnsApp) -> None:
         app.scene.set_initial_camera()
         page.mouse.move(5, 5)
         dismiss_notifications(page)
-        wait_for_frames(page, 30)
+        settle_for_picture(page, 30)
         assert screenshot(page, "app_trep2").stat().st_size > 10_000

@@ -17,7 +17,7 @@ from tests.browser import (
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
     screenshot,
-    wait_for_frames,
+    settle_for_picture,
     wait_for_nodes,
     wait_until,
 )
@@ -80,17 +80,17 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
         page.mouse.move(5, 5)
         page.get_by_text("Gain explorer", exact=True).scroll_into_view_if_needed()
         dismiss_notifications(page)
-        wait_for_frames(page, 40)
+        settle_for_picture(page, 40)
         path = screenshot(page, f"gain_map_{app.model_name}")
         assert path.stat().st_size > 10_000
         page.get_by_text("Root locus: g_m", exact=False).first.scroll_into_view_if_needed()
-        wait_for_frames(page, 10)
+        settle_for_picture(page, 10)
         assert screenshot(page, f"gain_loci_{app.model_name}").stat().st_size > 10_000
         # The arm mode's map: the second subsystem of Sec. VIII.
         legend = ex.scene.legend
         app.controls.show(ex.quantity, next(k for k, q in QUANTITIES.items() if q == "arm"))
         wait_until(lambda: legend.text.startswith("σ_a"), 10.0, "the arm mode's map")
-        wait_for_frames(page, 20)
+        settle_for_picture(page, 20)
         assert screenshot(page, f"gain_map_arm_{app.model_name}").stat().st_size > 10_000
         assert np.isfinite(app.session.gain_view().predicted)
         if app.model_name == "trep":  # predicted vs measured, after a kick from the page's button
@@ -100,7 +100,7 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
             wait_until(lambda: "measured" in ex.predicted.content, 10.0, "the panel to show it")
             page.get_by_text("Map shows", exact=True).first.scroll_into_view_if_needed()  # (the text above re-renders)
             dismiss_notifications(page)
-            wait_for_frames(page, 20)
+            settle_for_picture(page, 20)
             assert screenshot(page, "gain_measured_trep").stat().st_size > 10_000
             view = app.session.gain_view()
             print(f"predicted {view.predicted:.3f} 1/s, measured {view.measured.rate:.3f} 1/s")

@@ -31,7 +31,7 @@ from tests.browser import (
     browser_marks,
     browser_page,
     dismiss_notifications,
-    wait_for_frames,
+    settle_for_picture,
     wait_for_nodes,
     wait_until,
 )
@@ -80,7 +80,7 @@ def shoot(page: Page, name: str) -> Path:
     SHOTS.mkdir(parents=True, exist_ok=True)
     page.mouse.move(5, 5)
     dismiss_notifications(page)
-    wait_for_frames(page, 15)
+    settle_for_picture(page, 15)
     path = SHOTS / f"{name}.png"
     page.screenshot(path=str(path))
     Image.open(path).convert("RGB").quantize(256).save(path, optimize=True)  # a third of the bytes, for docs/

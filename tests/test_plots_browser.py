@@ -24,7 +24,7 @@ from tests.browser import (
     browser_page,
     dismiss_notifications,
     screenshot,
-    wait_for_frames,
+    settle_for_picture,
     wait_until,
 )
 
@@ -91,7 +91,7 @@ def shoot(page: Page, name: str, top: str = "Operate") -> None:
     page.get_by_text(top, exact=True).evaluate("e => e.scrollIntoView({block: 'start'})")
     page.mouse.move(5, 5)
     dismiss_notifications(page)
-    wait_for_frames(page, 10)
+    settle_for_picture(page, 10)
     screenshot(page, name)
 
 

@@ -18,7 +18,7 @@ from tests.browser import (
     browser_marks,
     browser_page,
     dismiss_notifications,
-    wait_for_frames,
+    settle_for_picture,
     wait_for_nodes,
     wait_until,
 )
@@ -53,11 +53,11 @@ def test_rank_inset_in_chromium() -> None:
             )
             assert page.get_by_text("Blue dot: the arm now", exact=False).first.is_visible()
             assert panel.theta is not None and np.all(np.isfinite(panel.theta))
-            wait_for_frames(page, 10)
+            settle_for_picture(page, 10)
             SHOTS.mkdir(parents=True, exist_ok=True)
             folder = title.locator("xpath=ancestor::*[.//img][1]")
             folder.evaluate("(e) => e.scrollIntoView({block: 'center'})")
-            wait_for_frames(page, 5)
+            settle_for_picture(page, 5)
             box = folder.bounding_box()
             assert box is not None
             clip = {"x": box["x"] - 8, "y": box["y"] - 12, "width": box["width"] + 16, "height": box["height"] + 20}

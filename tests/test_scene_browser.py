@@ -19,7 +19,7 @@ from tests.browser import (
     local_position,
     local_server,
     screenshot,
-    wait_for_frames,
+    settle_for_picture,
     wait_for_nodes,
     wait_until,
 )
@@ -81,6 +81,6 @@ def test_scene_renders_in_chromium(name: str) -> None:
             for theta in arm_motion:
                 scene.update(model.q(theta, [x_b]), gain)
             dismiss_notifications(page)
-            wait_for_frames(page, 20)
+            settle_for_picture(page, 20)
             path = screenshot(page, f"scene_{name}")
             assert _orange_pixels(path.read_bytes()) > 30, f"robot not visible in {path}"

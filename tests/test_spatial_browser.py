@@ -18,6 +18,7 @@ from tests.browser import (
     browser_page,
     dismiss_notifications,
     screenshot,
+    settle_for_picture,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
@@ -70,10 +71,10 @@ def test_boom7_in_chromium_kick_and_scrub_the_reactionless_path(boom_app: RnsApp
         page.mouse.move(5, 5)
         page.get_by_text("Operate", exact=True).scroll_into_view_if_needed()
         dismiss_notifications(page)
-        wait_for_frames(page, 30)
+        settle_for_picture(page, 30)
         assert screenshot(page, "app_boom7").stat().st_size > 10_000
         page.get_by_text("Base coordinates (spatial)", exact=True).scroll_into_view_if_needed()
-        wait_for_frames(page, 10)
+        settle_for_picture(page, 10)
         assert screenshot(page, "app_boom7_base_panel").stat().st_size > 10_000
 
 
@@ -142,7 +143,7 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         app.scene.set_initial_camera()
         page.mouse.move(5, 5)
         dismiss_notifications(page)
-        wait_for_frames(page, 30)
+        settle_for_picture(page, 30)
         assert screenshot(page, "app_boom7_reach").stat().st_size > 10_000
 
 
@@ -183,5 +184,5 @@ def test_boom7_r1_pose_target_turns_the_hand_with_the_rotation_rings(boom_app: R
         page.mouse.move(5, 5)
         label.first.scroll_into_view_if_needed()
         dismiss_notifications(page)
-        wait_for_frames(page, 30)
+        settle_for_picture(page, 30)
         assert screenshot(page, "app_boom7_orientation").stat().st_size > 10_000

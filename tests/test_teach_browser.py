@@ -34,6 +34,7 @@ from tests.browser import (
     dismiss_notifications,
     local_position,
     screenshot,
+    settle_for_picture,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
@@ -57,7 +58,7 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         page.get_by_text("Lesson 1 of 6", exact=False).wait_for(timeout=20_000)
         wait_until(lambda: not app.view.on("ghost"), 10.0, "lesson 1's view")  # no ghost: not explained yet
         page.mouse.move(5, 5)
-        wait_for_frames(page, 20)
+        settle_for_picture(page, 20)
         assert screenshot(page, "lesson1_start").stat().st_size > 10_000
         # The student ticks the ghost under "Show in the scene", then scrolls back to the lesson.
         page.get_by_text("Show in the scene", exact=True).click()
@@ -78,7 +79,7 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         assert pos is not None
         page.mouse.move(5, 5)
         dismiss_notifications(page)
-        wait_for_frames(page, 20)
+        settle_for_picture(page, 20)
         assert screenshot(page, "ghost_trep").stat().st_size > 10_000
         shadow_x = 50.0 * s.snapshot().q_shadow[0]
         operated_x = 50.0 * s.snapshot().q[0]
@@ -87,7 +88,7 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         wait_until(lambda: s.snapshot().lesson is not None and s.snapshot().lesson.done, 40.0, "lesson 1's check")
         page.get_by_text("Lesson 1 of 6: The base is a spring ✓", exact=False).wait_for(timeout=20_000)
         dismiss_notifications(page)
-        wait_for_frames(page, 20)
+        settle_for_picture(page, 20)
         assert screenshot(page, "lesson1_done").stat().st_size > 10_000
 
         # Pictures: one button, a PNG of the scene rendered by the browser, downloaded.
@@ -136,7 +137,7 @@ def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
                         seen.add(round(pos[0], 5))
                     time.sleep(0.1)
                 assert len(seen) >= 3, f"the base did not move in the player: {seen}"
-                wait_for_frames(page, 20)
+                settle_for_picture(page, 20)
                 assert screenshot(page, "playback_trep").stat().st_size > 10_000
             finally:
                 browser.close()
