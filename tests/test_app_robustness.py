@@ -83,3 +83,32 @@ def test_with_a_password_unknown_clients_only_watch() -> None:
     finally:
         ws.close()
         app.stop()
+
+
+def test_a_scene_build_that_fails_once_is_done_again_whole(trep_app: RnsApp, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A model switch whose scene build raises half-way (viser's message buffer once raised "deque mutated
+    during iteration" there, a message from the render thread racing viser's event loop) is built again
+    from a reset scene at the next frame: the app reaches the new model with its overlays, not a scene
+    whose labels were removed under it for good."""
+    import rns_viz.viz.render as render
+
+    real, failures = render.TeachScene, []
+
+    def flaky(*args: object, **kwargs: object) -> render.TeachScene:
+        if not failures:
+            failures.append(1)
+            raise RuntimeError("deque mutated during iteration")  # what viser raised
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(render, "TeachScene", flaky)
+    s = trep_app.session
+    s.switch_model("planar3r")
+    s.advance(0.1)
+    wait_until(lambda: trep_app.model_name == "planar3r", 20.0, "the 3R's scene")
+    assert failures == [1]
+    drawn = trep_app.renderer
+    drawn.teach.null_label.visible = drawn.teach.null_label.visible  # raises on a label removed under the scene
+    frames = drawn.scene_updates
+    s.kick(5.0)
+    s.advance(0.5)
+    wait_until(lambda: drawn.scene_updates > frames + 3, 10.0, "frames of the new scene")

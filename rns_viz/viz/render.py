@@ -123,17 +123,20 @@ class Renderer:
         return self.model.ee_position(snap.q[self.model.m :])
 
     def _rebuild_for_model(self, snap: Snapshot) -> None:
+        """The scene and controls of the session's model. The model counts as drawn only once all of it is
+        built: a failed build (viser's message buffer can raise when a thread's message races its event
+        loop) is done again from a reset scene at the next frame, not left half-built for good."""
         self.server.scene.reset()
-        self.model_name = snap.settings.model
         self._build_scene(snap)
         g, controls = self.gui, self.controls
         with controls.quiet():
-            defaults = defaults_for(self.model_name)
+            defaults = defaults_for(snap.settings.model)
             g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
         self._seen = _Seen()
         self.sync_settings(snap)
+        self.model_name = snap.settings.model
 
     # ---------------------------------------------------------------- the loop
     def _loop(self) -> None:
