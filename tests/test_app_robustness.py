@@ -108,7 +108,8 @@ def test_a_scene_build_that_fails_once_is_done_again_whole(trep_app: RnsApp, mon
     assert failures == [1]
     drawn = trep_app.renderer
     drawn.teach.null_label.visible = drawn.teach.null_label.visible  # raises on a label removed under the scene
-    frames = drawn.scene_updates
     s.kick(5.0)
-    s.advance(0.5)
-    wait_until(lambda: drawn.scene_updates > frames + 3, 10.0, "frames of the new scene")
+    for step in range(3):  # each step moves the arm, and the new scene draws it
+        frames = drawn.scene_updates
+        s.advance(0.1)
+        wait_until(lambda frames=frames: drawn.scene_updates > frames, 10.0, f"the new scene's frame {step + 1}")

@@ -134,7 +134,8 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         except AssertionError as e:
             rr = s.state.operator.rr  # type: ignore[union-attr]
             raise AssertionError(f"{e}: {gap() * 1e3:.1f} mm from the target, blocked at a fold: {rr.blocked}") from e
-        L = np.stack([s.state.runs.sim.log.column(f"L_{i}", last=3000) for i in (1, 2, 3)])
+        log = s.state.runs.sim.log  # one read of its rows: the loop appends to it meanwhile
+        L = log.array(3000)[:, [log.index[f"L_{i}"] for i in (1, 2, 3)]]
         # kg m/s. What is left is the arm lagging its reactionless reference each time the target starts and
         # stops: a mouse drag is ten small moves, so it depends on how the page spaces them (0.05-0.12 measured
         # with pages of different speeds; the bound is 0.25). One programmed move keeps under 1 % of the
