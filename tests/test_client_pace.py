@@ -12,9 +12,10 @@ from typing import Any
 
 import numpy as np
 import pytest
+from viser import _messages as m
 
 from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.client_pace import _paced
+from rns_viz.viz.client_pace import _paced, touches_scene
 from rns_viz.viz.pace_control import (
     FAST_ANSWER_S,
     FULL_HZ,
@@ -242,10 +243,6 @@ def test_a_running_app_at_rest_asks_nothing_while_only_the_panel_changes() -> No
 def test_only_windows_with_scene_messages_touch_the_scene() -> None:
     """The GUI-only set matches what viser's page applies without a frame: panel values, new controls
     and notifications are GUI-only; a pose, a scene node or a localStorage question is not."""
-    from viser import _messages as m
-
-    from rns_viz.viz.client_pace import touches_scene
-
     gui = m.GuiUpdateMessage(uuid="u", updates={"value": 1.0})
     note = m.RemoveNotificationMessage(uuid="n")
     pose = m.SetPositionMessage(name="/base", position=(0.0, 0.0, 0.0))
