@@ -13,7 +13,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family
 from rns_viz.viz import FsmsScene
 from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
-from rns_viz.viz.geometry import Trail, guided_cantilever, path_family_segments, zigzag
+from rns_viz.viz.geometry import Trail, guided_cantilever, path_family_segments, simplify, zigzag
 from rns_viz.viz.scene import PATH_HIGHLIGHT
 
 
@@ -89,31 +89,66 @@ def test_cart_and_spring_follow_the_base(planar_scene: FsmsScene, planar3r: Fsms
     assert np.allclose(points[-1, 1], [0.3 + spring.attach[0], 0.0, spring.attach[2]], atol=1e-6)
 
 
+def _distance_to_segments(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Each point's distance (m) to the nearest of the segments (K, 2, 3): a test oracle."""
+    a, b = segments[:, 0], segments[:, 1]
+    ab = b - a
+    rel = points[:, None, :] - a[None]
+    t = np.clip(np.einsum("pkj,kj->pk", rel, ab) / np.maximum(np.einsum("kj,kj->k", ab, ab), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(rel - t[..., None] * ab[None], axis=2).min(axis=1)
+
+
+def _drawn_path(points: np.ndarray, is_path: np.ndarray) -> np.ndarray:
+    """The drawn segments of one path, checked to join end to start."""
+    mine = points[is_path]
+    assert np.allclose(mine[1:, 0], mine[:-1, 1])
+    return mine
+
+
 def test_path_family_is_one_node_with_the_current_path_highlighted(trep_scene: FsmsScene, trep: FsmsModel) -> None:
     paths = path_family(trep, 12)
     trep_scene.set_path_family(paths, 3)
     points, colours = np.asarray(trep_scene.paths.points), np.asarray(trep_scene.paths.colors)
-    per_path = [min(len(p.ee), trep_scene.style.path_points) - 1 for p in paths]
-    assert points.shape == (sum(per_path), 2, 3)
-    assert colours.shape == points.shape
+    assert colours.shape == points.shape and points.shape[1:] == (2, 3)
+    assert len(points) < sum(min(len(p.ee), trep_scene.style.path_points) - 1 for p in paths)  # simplified
     highlight = (np.array(PATH_HIGHLIGHT) * 255).astype(np.uint8)
     is_current = np.all(colours == highlight, axis=(1, 2))
-    assert is_current.sum() == per_path[3] and np.all(is_current[-per_path[3] :])  # drawn last, on top
-    assert np.allclose(points[is_current][:, 0], paths[3].ee[:-1], atol=1e-6)
+    assert np.all(is_current[-is_current.sum() :])  # drawn last, on top
+    tolerance = trep_scene.style.path_tolerance
+    assert 0.0 < tolerance <= trep_scene.style.line_thickness / 10
+    drawn, ee = _drawn_path(points, is_current), paths[3].ee
+    assert np.allclose(drawn[0, 0], ee[0], atol=1e-6) and np.allclose(drawn[-1, 1], ee[-1], atol=1e-6)
+    assert _distance_to_segments(drawn[:, 0], ee[:, None, :].repeat(2, axis=1)).max() < 1e-6  # its own points
+    assert _distance_to_segments(ee, drawn).max() <= tolerance + 1e-6  # and never farther than the tolerance
     trep_scene.set_current_path(5)  # recolour only
     is_current = np.all(np.asarray(trep_scene.paths.colors) == highlight, axis=(1, 2))
-    assert is_current.sum() == per_path[5]
-    assert np.allclose(points[is_current][:, 0], paths[5].ee[:-1], atol=1e-6)
+    drawn = _drawn_path(points, is_current)
+    assert np.allclose(drawn[0, 0], paths[5].ee[0], atol=1e-6) and np.allclose(drawn[-1, 1], paths[5].ee[-1], atol=1e-6)
+    assert _distance_to_segments(paths[5].ee, drawn).max() <= tolerance + 1e-6
     with pytest.raises(IndexError):
         trep_scene.set_path_family(paths, len(paths))
 
 
 def test_long_paths_are_thinned() -> None:
-    curve = np.column_stack([np.linspace(0, 1, 1000), np.zeros(1000), np.zeros(1000)])
+    curve = np.column_stack([np.linspace(0, 1, 1000), np.sin(np.linspace(0, 6, 1000)), np.zeros(1000)])
     segs, colours, owners = path_family_segments([curve, curve[:10]], None, 100, (0.5, 0.5, 0.5), (1, 0, 0))
-    assert len(segs) == 99 + 9 and np.all(owners[:99] == 0)
+    assert len(segs) == 99 + 9 and np.all(owners[:99] == 0)  # tolerance 0: every thinned point is kept
     assert np.allclose(segs[0, 0], curve[0]) and np.allclose(segs[98, 1], curve[-1])
     assert np.allclose(colours, 0.5)
+
+
+@pytest.mark.parametrize("tolerance", [1e-4, 1e-3, 1e-2])
+def test_simplified_paths_stay_within_the_tolerance_with_fewer_points(tolerance: float) -> None:
+    s = np.linspace(0.0, 1.0, 2000)
+    curve = np.column_stack([s, 0.2 * np.sin(7 * s), 0.05 * np.cos(3 * s)])
+    kept = simplify(curve, tolerance)
+    assert np.all(np.isin(kept, curve).all(axis=1)) and np.array_equal(kept[[0, -1]], curve[[0, -1]])
+    assert len(kept) < len(curve) / 4
+    assert _distance_to_segments(curve, np.stack([kept[:-1], kept[1:]], axis=1)).max() <= tolerance
+    line = np.column_stack([s, 2 * s, -s])
+    assert len(simplify(line, tolerance)) == 2  # a straight line is its two ends
+    there_and_back = np.array([[0.0, 0, 0], [1.0, 0, 0], [0.0, 0, 0]])
+    assert len(simplify(there_and_back, tolerance)) == 3  # a reversal is kept, however short its chord
 
 
 def test_reachable_set_target_and_force(planar_scene: FsmsScene) -> None:

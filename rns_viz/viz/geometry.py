@@ -77,22 +77,55 @@ def thin(points: np.ndarray, max_points: int) -> np.ndarray:
     return points[idx]
 
 
+def simplify(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """The polyline's points that keep it within ``tolerance`` (m) of the original (Ramer-Douglas-Peucker).
+
+    Both ends are kept; every dropped point lies within ``tolerance`` of the chord that replaces it.
+    A browser without a GPU draws a line segment by segment, so fewer segments is a faster frame.
+    """
+    n = len(points)
+    if n < 3:
+        return points
+    keep = np.zeros(n, dtype=bool)
+    keep[[0, -1]] = True
+    spans = [(0, n - 1)]
+    while spans:
+        first, last = spans.pop()
+        if last - first < 2:
+            continue
+        chord = points[last] - points[first]
+        offsets = points[first + 1 : last] - points[first]
+        length_sq = float(chord @ chord)
+        if length_sq > 0.0:
+            along = np.clip(offsets @ chord / length_sq, 0.0, 1.0)
+            offsets = offsets - np.outer(along, chord)
+        distance = np.linalg.norm(offsets, axis=1)
+        farthest = int(np.argmax(distance))
+        if distance[farthest] > tolerance:
+            split = first + 1 + farthest
+            keep[split] = True
+            spans += [(first, split), (split, last)]
+    return points[keep]
+
+
 def path_family_segments(
     polylines: Sequence[np.ndarray],
     current: int | None,
     max_points: int,
     colour: tuple[float, float, float],
     highlight: tuple[float, float, float],
+    tolerance: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """All polylines as one segment array, with colours and each segment's polyline index.
 
+    Each polyline is thinned to ``max_points`` and then simplified to within ``tolerance`` (m).
     Returns (segments (N, 2, 3), colours (N, 2, 3) in [0, 1], owner (N,)). The current polyline
     is moved last so it draws over the others where they cross.
     """
     order = [i for i in range(len(polylines)) if i != current] + ([current] if current is not None else [])
     segs, owner = [], []
     for i in order:
-        pts = thin(np.asarray(polylines[i], dtype=float), max_points)
+        pts = simplify(thin(np.asarray(polylines[i], dtype=float), max_points), tolerance)
         if len(pts) >= 2:
             segs.append(polyline_segments(pts))
             owner.append(np.full(len(pts) - 1, i))

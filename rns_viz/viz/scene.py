@@ -189,7 +189,7 @@ class FsmsScene:
         if current_index is not None and not 0 <= current_index < len(curves):
             raise IndexError(f"current_index {current_index} is not one of the {len(curves)} paths")
         segs, colours, owners = path_family_segments(
-            curves, current_index, self.style.path_points, PATH_COLOUR, PATH_HIGHLIGHT
+            curves, current_index, self.style.path_points, PATH_COLOUR, PATH_HIGHLIGHT, self.style.path_tolerance
         )
         self._path_owners, self.current_path = owners, current_index
         with self.server.atomic():

@@ -70,6 +70,12 @@ class SceneStyle:
     trail_step: float = 0.0  # m between kept trail points; 0 means marker_radius / 4
     trail_jump: float = np.inf  # m; a longer jump of the end effector starts a new trail
     path_points: int = 240  # at most this many points per drawn path
+
+    @property
+    def path_tolerance(self) -> float:
+        """m a drawn path may stray from the computed one: a twelfth of the line's own width."""
+        return self.line_thickness / 12.0
+
     up: Literal["+z"] = "+z"
 
 
