@@ -83,6 +83,9 @@ class FsmsModel:
         self.arm_joint_names: tuple[str, ...] = tuple(names[self.m :])
         self.arm_groups = _arm_branches(spec, self.arm_joint_names, model)
         self.selected = np.flatnonzero(spec.base.selection)
+        contiguous = len(self.selected) and self.selected[-1] - self.selected[0] + 1 == len(self.selected)
+        # rows of S as a slice where they run together (a view, ~10x cheaper than fancy indexing)
+        self._coupling_rows = slice(int(self.selected[0]), int(self.selected[-1]) + 1) if contiguous else self.selected
         self.task_rows = np.array([_AXIS_INDEX[a] for a in spec.task_axes])
         self.lower = model.lowerPositionLimit[self.m :].copy()
         self.upper = model.upperPositionLimit[self.m :].copy()
@@ -156,7 +159,7 @@ class FsmsModel:
 
     def coupling_matrix(self, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """S H_bm: the rows of the inertia coupling matrix selected by S (Sec. III-B)."""
-        return self.mass_matrix(q, data)[self.selected, self.m :]
+        return self.mass_matrix(q, data)[self._coupling_rows, self.m :]
 
     def dynamics(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, the velocity terms c = (c_b, c_m) and H_bm' theta' at (q, v): what the laws need.

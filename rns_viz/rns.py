@@ -194,6 +194,8 @@ def null_vector(H_bm: np.ndarray) -> np.ndarray:
     ``H_bm`` may be one (m, m + 1) matrix or a stack (K, m, m + 1); n is then (K, m + 1).
     """
     H = np.asarray(H_bm, dtype=float)
+    if H.shape == (1, 2):  # one row, one matrix (TREP, the 3R): Eq. (27) as it stands, at every path step
+        return np.array((H[0, 1], -H[0, 0]))
     if H.ndim == 1:
         H = H[None]
     rows, cols = H.shape[-2:]

@@ -105,11 +105,17 @@ class PathReference:
             self.t0 = t0
         self._t = self.t0
         self._theta = self.theta0.copy()
+        self._n_here: np.ndarray | None = None  # n(theta_ref) at the current point, once evaluated
 
     def n(self, theta: np.ndarray) -> np.ndarray:
         """Null-space vector n(theta) (Eq. 27 generalised), kg m."""
         self._q[self.model.m :] = theta
         return null_vector(self.model.coupling_matrix(self._q, self.data))
+
+    def _n_at_current(self) -> np.ndarray:
+        if self._n_here is None:
+            self._n_here = self.n(self._theta)
+        return self._n_here
 
     def _advance(self, t: float) -> None:
         if t < self._t - 1e-12:
@@ -117,18 +123,19 @@ class PathReference:
         while self._t < t - 1e-12:
             h = min(self.max_step, t - self._t)
             t_, th = self._t, self._theta
-            k1 = self.n(th) * self.ubar(t_)[0]
-            k2 = self.n(th + 0.5 * h * k1) * self.ubar(t_ + 0.5 * h)[0]
-            k3 = self.n(th + 0.5 * h * k2) * self.ubar(t_ + 0.5 * h)[0]
+            u_mid = self.ubar(t_ + 0.5 * h)[0]
+            k1 = self._n_at_current() * self.ubar(t_)[0]  # the last query's n(theta), at this point
+            k2 = self.n(th + 0.5 * h * k1) * u_mid
+            k3 = self.n(th + 0.5 * h * k2) * u_mid
             k4 = self.n(th + h * k3) * self.ubar(t_ + h)[0]
             self._theta = th + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            self._t = t_ + h
+            self._t, self._n_here = t_ + h, None
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         self._advance(t)
         theta = self._theta.copy()
         u, du = self.ubar(t)
-        n = self.n(theta)
+        n = self._n_at_current()
         eps = 1e-6
         dn_along_n = (self.n(theta + eps * n) - self.n(theta - eps * n)) / (2 * eps)  # (Dn) n
         return theta, n * u, dn_along_n * u * u + n * du
