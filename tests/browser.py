@@ -17,7 +17,7 @@ from typing import Any
 
 import pytest
 import viser
-from playwright.sync_api import Page, sync_playwright
+from playwright.sync_api import Browser, Page, sync_playwright
 
 from rns_viz.viz.app import RnsApp, start_app
 
@@ -32,17 +32,31 @@ CHROMIUM_FLAGS = [
     "--disable-component-update",
     "--disable-sync",
 ]
-# Chromium's switch for tests that need no pixels: WebGL calls run (three.js builds and updates its scene
-# graph, raycasts, uploads buffers), but the GPU process rasterises nothing. Software WebGL drew a frame
-# of the app in ~0.3 s of CPU at 1280x800, so a page drawing its scene held most of a core while a test
-# ran. Pages whose pixels a test reads or saves for people to look at draw: ``draw=True``, and every page
-# while pictures are made (RNS_VIZ_SCREENSHOTS, or RNS_VIZ_DRAW=1 for artifacts/ too).
+# Pages of tests that need no pixels draw nothing. Chromium's switch for it skips little on software WebGL
+# (SwiftShader still rasterised the app's draws: ~0.19 s of CPU a frame at 1280x800), so such a page is
+# also given NO_DRAWING_SCRIPT: WebGL's draw and clear calls return at once, while everything else runs
+# (three.js builds and updates its scene graph, raycasts, uploads buffers; React and the panel as ever).
+# A frame then costs ~0.025 s: a page at rest uses 2 % of a core instead of 20 %, and a Playwright call,
+# which waits for the page's next frame, waits that much less. Pages whose pixels a test reads or saves
+# for people to look at draw: ``draw=True``, and every page while pictures are made (RNS_VIZ_SCREENSHOTS,
+# or RNS_VIZ_DRAW=1 for artifacts/ too).
 NO_DRAWING = "--disable-gl-drawing-for-tests"
+NO_DRAWING_SCRIPT = """
+for (const context of [WebGLRenderingContext, WebGL2RenderingContext]) {
+  for (const call of ["drawArrays", "drawElements", "drawArraysInstanced", "drawElementsInstanced",
+                      "drawRangeElements", "clear"]) {
+    const original = context.prototype[call];
+    if (original) context.prototype[call] = function (...args) {
+      if (window.__rnsDrawing) return original.apply(this, args);  // start_drawing(page)
+    };
+  }
+}
+"""
 ARTIFACTS = Path(__file__).resolve().parent.parent / "artifacts"
 SKIP_REASON = f"real-browser test needs Debian chromium at {CHROMIUM} (apt-get install chromium)"
 
 
-_DRAWING_PAGES: weakref.WeakSet[Page] = weakref.WeakSet()  # the pages opened with draw=True
+_DRAWING_PAGES: weakref.WeakSet[Page] = weakref.WeakSet()  # the pages that draw (draw=True or pictures wanted)
 
 
 def pictures_wanted() -> bool:
@@ -53,6 +67,16 @@ def pictures_wanted() -> bool:
 def chromium_flags(draw: bool = False) -> list[str]:
     """The flags of a test's chromium: it draws its 3-D scene only if ``draw`` or pictures are wanted."""
     return CHROMIUM_FLAGS if draw or pictures_wanted() else [*CHROMIUM_FLAGS, NO_DRAWING]
+
+
+def new_test_page(browser: Browser, width: int, height: int, draw: bool = False) -> Page:
+    """A page of ``browser``: its WebGL draws nothing unless ``draw`` or pictures are wanted."""
+    page = browser.new_page(viewport={"width": width, "height": height})
+    if draw or pictures_wanted():
+        _DRAWING_PAGES.add(page)
+    else:
+        page.add_init_script(NO_DRAWING_SCRIPT)
+    return page
 
 
 def chromium_available() -> bool:
@@ -109,9 +133,7 @@ def browser_page(
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(draw), headless=True)
         try:
-            page = browser.new_page(viewport={"width": width, "height": height})
-            if draw:
-                _DRAWING_PAGES.add(page)
+            page = new_test_page(browser, width, height, draw)
             page.goto(f"http://127.0.0.1:{server.get_port()}/", timeout=timeout * 1000)
             wait_until(lambda: len(server.get_clients()) > 0, timeout, "the browser to connect to viser")
             yield page
@@ -172,10 +194,18 @@ def wait_for_frames(page: Page, frames: int = 30) -> None:
     )
 
 
+def start_drawing(page: Page, frames: int = 3) -> None:
+    """Let a page opened without drawing draw its scene from now on, and wait ``frames`` drawn frames
+    (for a test that reads the scene's pixels only at its end)."""
+    page.evaluate("() => { window.__rnsDrawing = true; }")
+    _DRAWING_PAGES.add(page)
+    wait_for_frames(page, frames)
+
+
 def settle_for_picture(page: Page, frames: int) -> None:
     """Before a screenshot: ``frames`` animation frames on a page that draws its scene (``draw=True``, or
     pictures wanted), so the picture shows it settled; 2 on a page that draws no pixels, whose picture
-    shows the panel, which the page has laid out by then (each software-rendered frame takes ~0.2 s)."""
+    shows the panel, which the page has laid out by then (each software-rendered frame took ~0.2 s)."""
     wait_for_frames(page, frames if page in _DRAWING_PAGES or pictures_wanted() else 2)
 
 

@@ -33,8 +33,10 @@ from tests.browser import (
     chromium_flags,
     dismiss_notifications,
     local_position,
+    new_test_page,
     screenshot,
     settle_for_picture,
+    start_drawing,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
@@ -91,7 +93,8 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         settle_for_picture(page, 20)
         assert screenshot(page, "lesson1_done").stat().st_size > 10_000
 
-        # Pictures: one button, a PNG of the scene rendered by the browser, downloaded.
+        # Pictures: one button, a PNG of the scene rendered by the browser, downloaded (so drawn from here).
+        start_drawing(page)
         with page.expect_download(timeout=60_000) as download:
             page.get_by_role("button", name="Save picture (PNG)").click()
         path = ARTIFACTS / "picture_trep.png"
@@ -126,7 +129,7 @@ def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(), headless=True)
             try:
-                page = browser.new_page(viewport={"width": 1280, "height": 800})
+                page = new_test_page(browser, 1280, 800)
                 page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}", timeout=60_000)
                 wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, FsmsScene.ROBOT}, timeout=60.0)
                 seen = set()
