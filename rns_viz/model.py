@@ -83,8 +83,9 @@ class FsmsModel:
         self.arm_joint_names: tuple[str, ...] = tuple(names[self.m :])
         self.arm_groups = _arm_branches(spec, self.arm_joint_names, model)
         self.selected = np.flatnonzero(spec.base.selection)
-        contiguous = len(self.selected) and self.selected[-1] - self.selected[0] + 1 == len(self.selected)
-        # rows of S as a slice where they run together (a view, ~10x cheaper than fancy indexing)
+        # S's rows as a slice where they run together: a view of pinocchio's fresh M (crba returns a
+        # copy), 0.45 us where fancy indexing took 2.6 (boom7), in every reactionless-path step
+        contiguous = len(self.selected) > 0 and bool(np.all(np.diff(self.selected) == 1))
         self._coupling_rows = slice(int(self.selected[0]), int(self.selected[-1]) + 1) if contiguous else self.selected
         self.task_rows = np.array([_AXIS_INDEX[a] for a in spec.task_axes])
         self.lower = model.lowerPositionLimit[self.m :].copy()
