@@ -86,7 +86,9 @@ class FsmsModel:
         # S's rows as a slice where they run together: a view of pinocchio's fresh M (crba returns a
         # copy), 0.45 us where fancy indexing took 2.6 (boom7), in every reactionless-path step
         contiguous = len(self.selected) > 0 and bool(np.all(np.diff(self.selected) == 1))
-        self._coupling_rows = slice(int(self.selected[0]), int(self.selected[-1]) + 1) if contiguous else self.selected
+        self._coupling_rows: slice | np.ndarray = (
+            slice(int(self.selected[0]), int(self.selected[-1]) + 1) if contiguous else self.selected
+        )
         self.task_rows = np.array([_AXIS_INDEX[a] for a in spec.task_axes])
         self.lower = model.lowerPositionLimit[self.m :].copy()
         self.upper = model.upperPositionLimit[self.m :].copy()

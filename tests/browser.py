@@ -195,8 +195,9 @@ def wait_for_frames(page: Page, frames: int = 30) -> None:
 
 
 def start_drawing(page: Page, frames: int = 3) -> None:
-    """Let a page opened without drawing draw its scene from now on, and wait ``frames`` drawn frames
-    (for a test that reads the scene's pixels only at its end)."""
+    """Give a page opened without drawing its WebGL draw and clear calls back from now on, and wait
+    ``frames`` frames (for a test that reads the scene's pixels only at its end). Chromium's switch,
+    set at launch, stays on: the page then draws as a ``draw=False`` page did before the script."""
     page.evaluate("() => { window.__rnsDrawing = true; }")
     _DRAWING_PAGES.add(page)
     wait_for_frames(page, frames)

@@ -65,7 +65,7 @@ def test_queries_in_any_order_give_the_path_through_the_same_points() -> None:
         theta, thetadot, _ = ref(t)
         assert np.array_equal(thetadot, ref.n(theta) * ubar(t)[0])  # n at the point reached, never a stale one
         straight = PathReference(model, theta0, ubar)(t)[0]  # the same time asked for at once
-        assert np.allclose(theta, straight, rtol=0.0, atol=1e-12)
+        assert np.allclose(theta, straight, rtol=0.0, atol=1e-10)  # other step grids: RK4's error only
     ref.restart(theta0=np.array([0.1, 0.2]))
     theta, thetadot, _ = ref(0.0)
     assert np.array_equal(theta, [0.1, 0.2]) and np.array_equal(thetadot, ref.n(theta) * ubar(0.0)[0])

@@ -81,10 +81,11 @@ def simplify(points: np.ndarray, tolerance: float) -> np.ndarray:
     """The polyline's points that keep it within ``tolerance`` (m) of the original (Ramer-Douglas-Peucker).
 
     Both ends are kept; every dropped point lies within ``tolerance`` of the chord that replaces it.
+    With fewer than 3 points or ``tolerance`` <= 0 the polyline is returned as given.
     A browser without a GPU draws a line segment by segment, so fewer segments is a faster frame.
     """
     n = len(points)
-    if n < 3:
+    if n < 3 or tolerance <= 0.0:  # a tolerance of 0 keeps every point, even collinear ones
         return points
     keep = np.zeros(n, dtype=bool)
     keep[[0, -1]] = True

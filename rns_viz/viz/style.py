@@ -71,12 +71,12 @@ class SceneStyle:
     trail_jump: float = np.inf  # m; a longer jump of the end effector starts a new trail
     path_points: int = 240  # at most this many points per drawn path
 
+    up: Literal["+z"] = "+z"
+
     @property
     def path_tolerance(self) -> float:
         """m a drawn path may stray from the computed one: a twelfth of the line's own width."""
         return self.line_thickness / 12.0
-
-    up: Literal["+z"] = "+z"
 
 
 def style_for(model: FsmsModel) -> SceneStyle:
