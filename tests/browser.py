@@ -66,13 +66,18 @@ def pictures_wanted() -> bool:
 
 def chromium_flags(draw: bool = False) -> list[str]:
     """The flags of a test's chromium: it draws its 3-D scene only if ``draw`` or pictures are wanted."""
-    return CHROMIUM_FLAGS if draw or pictures_wanted() else [*CHROMIUM_FLAGS, NO_DRAWING]
+    return CHROMIUM_FLAGS if draws(draw) else [*CHROMIUM_FLAGS, NO_DRAWING]
+
+
+def draws(draw: bool) -> bool:
+    """Whether a test's page draws its scene: asked for (``draw``), or pictures are wanted."""
+    return draw or pictures_wanted()
 
 
 def new_test_page(browser: Browser, width: int, height: int, draw: bool = False) -> Page:
     """A page of ``browser``: its WebGL draws nothing unless ``draw`` or pictures are wanted."""
     page = browser.new_page(viewport={"width": width, "height": height})
-    if draw or pictures_wanted():
+    if draws(draw):
         _DRAWING_PAGES.add(page)
     else:
         page.add_init_script(NO_DRAWING_SCRIPT)
@@ -207,7 +212,7 @@ def settle_for_picture(page: Page, frames: int) -> None:
     """Before a screenshot: ``frames`` animation frames on a page that draws its scene (``draw=True``, or
     pictures wanted), so the picture shows it settled; 2 on a page that draws no pixels, whose picture
     shows the panel, which the page has laid out by then (each software-rendered frame took ~0.2 s)."""
-    wait_for_frames(page, frames if page in _DRAWING_PAGES or pictures_wanted() else 2)
+    wait_for_frames(page, frames if page in _DRAWING_PAGES else 2)
 
 
 def screenshot(page: Page, name: str) -> Path:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import rns_viz.viz.render as render
 from rns_viz.control import InvalidGain
 from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
 from tests.app_helpers import queued, uuid
@@ -90,8 +91,6 @@ def test_a_scene_build_that_fails_once_is_done_again_whole(trep_app: RnsApp, mon
     during iteration" there, a message from the render thread racing viser's event loop) is built again
     from a reset scene at the next frame: the app reaches the new model with its overlays, not a scene
     whose labels were removed under it for good."""
-    import rns_viz.viz.render as render
-
     real, failures = render.TeachScene, []
 
     def flaky(*args: object, **kwargs: object) -> render.TeachScene:
