@@ -5,6 +5,7 @@ its data), the plot history restarting on a suppression switch, and presets that
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -53,17 +54,25 @@ def test_chart_options_never_change_with_presets_models_and_suppression() -> Non
         s, plots = app.session, app.gui.plots
         charts = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values()] + [plots.error]
         before = [_options(c) for c in charts]
-        s.kick(0.8)
-        s.advance(1.0)
-        s.set_suppression(False)
-        s.set_shadow(False)
-        s.advance(0.5)
-        s.load_preset("fig3")
-        s.advance(0.0)
-        assert s.wait_background()
-        s.advance(1.0)
-        wait_until(lambda: app.plot_updates > 2, 10.0, "plot updates")
-        assert [_options(c) for c in charts] == before
+
+        def sent(what: str, step: Callable[[], object]) -> None:
+            """Step the stepped app, then wait for the render loop to send that step's plots (the app is
+            not real-time: nothing changes between steps, so each phase must be seen on its own)."""
+            updates = app.plot_updates
+            step()
+            wait_until(lambda: app.plot_updates > updates, 10.0, f"the plots after {what}")
+            assert [_options(c) for c in charts] == before, what
+
+        sent("a kick", lambda: (s.kick(0.8), s.advance(1.0)))
+        sent("suppression and shadow off", lambda: (s.set_suppression(False), s.set_shadow(False), s.advance(0.5)))
+
+        def fig3() -> None:
+            s.load_preset("fig3")
+            s.advance(0.0)
+            assert s.wait_background()
+            s.advance(1.0)
+
+        sent("the fig3 preset", fig3)
     finally:
         app.stop()
 
