@@ -70,7 +70,6 @@ class SceneStyle:
     trail_step: float = 0.0  # m between kept trail points; 0 means marker_radius / 4
     trail_jump: float = np.inf  # m; a longer jump of the end effector starts a new trail
     path_points: int = 240  # at most this many points per drawn path
-
     up: Literal["+z"] = "+z"
 
     @property
