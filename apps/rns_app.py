@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import tyro
 
-from rns_viz.viz.app import serve
+from rns_viz.viz.server.app import serve
 
 
 def main(model: str = "trep", host: str = "127.0.0.1", port: int = 8080) -> None:

@@ -65,12 +65,12 @@ def rss_mb() -> float:
 def serve(model: str, teach: str | None = None) -> None:
     """Start the app, print its handles as JSON, then answer 'stats' lines until 'quit'.
     ``teach``: "on" shows every teaching view; "off" hides them all and switches the recorder off."""
-    from rns_viz.viz.app import TARGET_HANDLE, start_app
-    from rns_viz.viz.view_toggles import TOGGLES
+    from rns_viz.viz.scene.view_toggles import TOGGLES
+    from rns_viz.viz.server.app import TARGET_HANDLE, start_app
 
     out, sys.stdout = sys.stdout, sys.stderr  # viser prints a banner: keep the protocol pipe clean
     if teach == "off":  # the baseline records nothing (its ring buffer is never even allocated)
-        from rns_viz.live.recorder import Recorder
+        from rns_viz.live.outputs.recorder import Recorder
 
         Recorder.append = lambda *args: None  # type: ignore[method-assign]
     app = start_app(model, port=0, verbose=False)

@@ -27,8 +27,8 @@ LAWS = {"trep": ("velocity", "acceleration"), "planar3r": ("acceleration", "torq
 
 
 def main() -> None:
-    from rns_viz.viz.app import start_app
-    from rns_viz.viz.gain_scene import GainScene, axis_fraction
+    from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction
+    from rns_viz.viz.server.app import start_app
     from tests.browser import wait_for_clients, wait_until
     from tests.protocol_client import ProtocolClient
 

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from rns_viz.live.references import ResolvedRate
+from rns_viz.live.operator.moving_references import ResolvedRate
 from rns_viz.model import FsmsModel
 from rns_viz.rns import rns_projector
 

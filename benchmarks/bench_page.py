@@ -5,7 +5,7 @@ Run on demand (Debian chromium, software WebGL, as on a machine without a GPU):
     python benchmarks/bench_page.py                 # 5 min per browser run, 2 min hidden tab
     python benchmarks/bench_page.py --minutes 1 --hidden-minutes 0.5   # shortened
 
-Each scenario runs twice in the same run: with the per-client pacing of rns_viz.viz.client_pace
+Each scenario runs twice in the same run: with the per-client pacing of rns_viz.viz.server.page_pacing
 ("paced") and without it ("unpaced", every page gets every update, as before issue 14). The app
 runs in a child process (its real-time factor is not disturbed by the clients); TREP, default app.
 
@@ -50,7 +50,7 @@ KICK_EVERY_S = 10.0
 # ---------------------------------------------------------------- the app (a child process)
 def serve(pace: bool) -> None:
     """Start the app, print its port, then answer 'stats' lines until 'quit'."""
-    from rns_viz.viz.app import start_app
+    from rns_viz.viz.server.app import start_app
 
     out, sys.stdout = sys.stdout, sys.stderr  # viser prints a banner: keep the protocol pipe clean
     app = start_app("trep", port=0, verbose=False, pace=pace)

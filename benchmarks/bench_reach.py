@@ -22,9 +22,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from rns_viz.live.reach import VOXELS_PER_REACH, build_reach_region
-from rns_viz.live.reach_spatial import bracket_rank, explore_rns
-from rns_viz.live.readouts import arm_reach
+from rns_viz.live.reach.region import VOXELS_PER_REACH, arm_reach, build_reach_region
+from rns_viz.live.reach.spatial import bracket_rank, explore_rns
 from rns_viz.model import FsmsModel
 
 SELECTIONS = {

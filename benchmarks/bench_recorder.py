@@ -22,8 +22,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from rns_viz.live.recorder import Recorder  # noqa: E402
-from rns_viz.live.session import Session  # noqa: E402
+from rns_viz.live.loop.session import Session  # noqa: E402
+from rns_viz.live.outputs.recorder import Recorder  # noqa: E402
 
 KICKS = {"trep": 0.8, "planar3r": 5.0}
 

@@ -28,7 +28,7 @@ from bench_page import RAF_JS, chromium_cpu_s, load
 
 from rns_viz.model import FsmsModel
 from rns_viz.params import missing_extra
-from rns_viz.viz.robot import RobotMeshes
+from rns_viz.viz.scene.robot import RobotMeshes
 
 
 def server_side(name: str, frames: int = 2000) -> dict[str, float]:
@@ -67,7 +67,7 @@ def _meshes(model: FsmsModel) -> list:
 def browser_side(name: str, seconds: float = 4.0) -> dict[str, float]:
     from playwright.sync_api import sync_playwright
 
-    from rns_viz.viz.app import start_app
+    from rns_viz.viz.server.app import start_app
     from tests.browser import CHROMIUM, CHROMIUM_FLAGS
 
     app = start_app(name, port=0, verbose=False)

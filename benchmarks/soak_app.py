@@ -22,7 +22,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from rns_viz.model import FsmsModel
-from rns_viz.viz.app import TARGET_HANDLE, start_app
+from rns_viz.viz.server.app import TARGET_HANDLE, start_app
 from tests.protocol_client import ProtocolClient, gui_uuid
 
 

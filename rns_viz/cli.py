@@ -212,7 +212,7 @@ LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
 
 def cmd_serve(args: argparse.Namespace) -> None:
-    from rns_viz.viz.app import serve
+    from rns_viz.viz.server.app import serve
 
     if args.host not in LOOPBACK and not args.host.startswith("127."):
         gated = args.password or os.environ.get("RNS_VIZ_PASSWORD")
@@ -224,7 +224,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
         _load_model(name)
     model = models[0]
     if args.lesson is not None:
-        from rns_viz.live.lessons import LESSONS
+        from rns_viz.live.teaching.lessons import LESSONS
 
         if model not in LESSONS:
             raise CliError(f"{model} has no lessons; there are some for {', '.join(LESSONS)}")

@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from rns_viz.live.session import Session
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.live.loop.session import Session
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import wait_until
 
 

@@ -19,7 +19,7 @@ import pytest
 import viser
 from playwright.sync_api import Browser, Page, sync_playwright
 
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.server.app import RnsApp, start_app
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_FLAGS = [

@@ -7,9 +7,9 @@ from collections.abc import Iterator
 
 import pytest
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
-from rns_viz.viz.app import RnsApp
+from rns_viz.viz.server.app import RnsApp
 from tests.app_helpers import stepped_app, stepped_session
 from tests.browser import wait_for_clients
 from tests.protocol_client import ProtocolClient

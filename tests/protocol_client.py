@@ -6,7 +6,7 @@ transform drags) and drains what the server sends on a background thread, counti
 bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack windows and
 counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
 element (update rates for benchmarks). Like a browser it answers the server's localStorage
-questions (the app times them to pace slow pages, rns_viz.viz.client_pace); ``answer_delay_s``
+questions (the app times them to pace slow pages, rns_viz.viz.server.page_pacing); ``answer_delay_s``
 answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the answers back
 until ``thaw()``, as a frozen tab does. Only connects to loopback addresses (docs/testing-notes.md says why).
 """

@@ -15,9 +15,9 @@ import time
 import numpy as np
 import pytest
 
-from rns_viz.live.session import Session
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp, serve, start_app
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.live.loop.session import Session
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, serve, start_app
 from tests.app_helpers import queued, uuid
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient

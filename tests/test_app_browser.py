@@ -8,8 +8,8 @@ import time
 
 from playwright.sync_api import Page
 
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp
 from tests.browser import (
     browser_marks,
     browser_page,

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rns_viz.viz.app import TARGET_HANDLE, start_app
+from rns_viz.viz.server.app import TARGET_HANDLE, start_app
 from tests.browser import live_group, wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 

@@ -19,8 +19,8 @@ import viser
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
-from rns_viz.viz.gui import GuiElements
+from rns_viz.viz.panels.control_panel import GuiElements
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 

@@ -15,9 +15,9 @@ import pytest
 
 from rns_viz.cli import main
 from rns_viz.params import ASSETS_DIR
-from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.base_panel import BasePanel
-from rns_viz.viz.model_menu import MODEL_LABELS
+from rns_viz.viz.panels.base_panel import BasePanel
+from rns_viz.viz.panels.model_menu import MODEL_LABELS
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 

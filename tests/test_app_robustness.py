@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import rns_viz.viz.render as render
+import rns_viz.viz.server.render as render
 from rns_viz.control import InvalidGain
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
 from tests.app_helpers import queued, uuid
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient

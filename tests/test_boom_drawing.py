@@ -11,7 +11,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rns_viz.viz.boom_drawing import boom_frames, tube_faces, tube_vertices
+from rns_viz.viz.scene.boom_drawing import boom_frames, tube_faces, tube_vertices
 
 L = 4.0
 AXES = np.eye(3)  # along x, lateral y and z

@@ -27,9 +27,9 @@ from rns_viz.params import ASSETS_DIR, ModelFileError, missing_extra
 from rns_viz.rns import restricted_jacobian, rns_projector
 from rns_viz.scenarios import BOOM7_GAINS, BOOM7_KICK, FORCES_ONLY
 from rns_viz.sim import ForcePulse, Simulator
-from rns_viz.viz.app import start_app
-from rns_viz.viz.model_menu import MODEL_LABELS, ModelMenu, label_of
-from rns_viz.viz.robot import RobotMeshes
+from rns_viz.viz.panels.model_menu import MODEL_LABELS, ModelMenu, label_of
+from rns_viz.viz.scene.robot import RobotMeshes
+from rns_viz.viz.server.app import start_app
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from rns_viz import robots
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp
 from tests.app_helpers import realtime_app
 from tests.browser import (
     browser_marks,

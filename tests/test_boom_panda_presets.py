@@ -27,8 +27,8 @@ from rns_viz.scenarios import (
     run_scenario,
 )
 from rns_viz.sim import Simulator
-from rns_viz.viz.app import start_app
-from rns_viz.viz.gui import BOOM7_PRESETS, PANDA_PRESETS
+from rns_viz.viz.panels.control_panel import BOOM7_PRESETS, PANDA_PRESETS
+from rns_viz.viz.server.app import start_app
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 

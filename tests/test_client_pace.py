@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from viser import _messages as m
 
-from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.client_pace import _paced, touches_scene
-from rns_viz.viz.pace_control import (
+from rns_viz.viz.server.app import RnsApp, start_app
+from rns_viz.viz.server.page_pacing import _paced, touches_scene
+from rns_viz.viz.server.page_rate import (
     FAST_ANSWER_S,
     FULL_HZ,
     HOLD_BASES,

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.guard import MAX_JOINT_SPEED, Bounds
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
+from rns_viz.live.runs.divergence_guard import MAX_JOINT_SPEED, Bounds
 from rns_viz.model import FsmsModel
-from rns_viz.viz.app import start_app
+from rns_viz.viz.server.app import start_app
 from tests.browser import wait_until
 from tests.protocol_client import ProtocolClient
 

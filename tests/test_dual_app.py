@@ -10,8 +10,8 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.panel_text import BAD_COLOUR, OK_COLOUR, readouts_html
+from rns_viz.viz.panels.panel_text import BAD_COLOUR, OK_COLOUR, readouts_html
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import wait_until
 from tests.test_teach import independent_reaction, log_row
 

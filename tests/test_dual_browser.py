@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from playwright.sync_api import Page
 
-from rns_viz.viz.app import TARGET_HANDLE, RnsApp, start_app
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
 from tests.browser import (
     browser_marks,
     browser_page,

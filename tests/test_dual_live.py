@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from rns_viz.control import ControlOutput
-from rns_viz.live.dual import TaskWorkspace, compensation_state
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
+from rns_viz.live.operator.dual_arm import TaskWorkspace, compensation_state
 from rns_viz.model import FsmsModel
 from rns_viz.scenarios import DUAL_SCENARIOS, LIVE_SCENARIOS
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 
 
 @pytest.mark.parametrize(("model", "kick_n", "seconds"), [("trep", 0.8, 10.0), ("planar3r", 5.0, 16.0)])

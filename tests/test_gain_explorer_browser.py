@@ -8,9 +8,9 @@ import time
 import numpy as np
 from playwright.sync_api import Page
 
-from rns_viz.viz.app import RnsApp
-from rns_viz.viz.gain_panel import QUANTITIES
-from rns_viz.viz.gain_scene import GainScene, axis_fraction
+from rns_viz.viz.panels.gain_panel import QUANTITIES
+from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction
+from rns_viz.viz.server.app import RnsApp
 from tests.browser import (
     browser_marks,
     browser_page,

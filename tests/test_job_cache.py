@@ -1,4 +1,4 @@
-"""The helper process answers a request it has seen from its reply cache (rns_viz.live.jobs): the same
+"""The helper process answers a request it has seen from its reply cache (rns_viz.live.jobs.helper): the same
 bytes as computing it again, one computation for two requests, failures computed each time, and the
 least recently used replies leave first once the byte budget is spent."""
 
@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from rns_viz.live import jobs
+from rns_viz.live.jobs import helper as jobs
 from rns_viz.model import FsmsModel
 
 

@@ -1,5 +1,5 @@
 """A reachable set asked for while the gain explorer sweeps boom7's path goes first in the shared helper
-process (rns_viz.live.jobs): it waits for the one explorer call in flight, not the whole sweep; the
+process (rns_viz.live.jobs.helper): it waits for the one explorer call in flight, not the whole sweep; the
 explorer finishes after it, and both results equal the same computations made directly."""
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ import pytest
 
 from rns_viz.analysis import authority, loops_along
 from rns_viz.control import Gains
-from rns_viz.live import jobs
-from rns_viz.live.background import Background, ReachReady
-from rns_viz.live.gain_explorer import AUTHORITY_CHUNK, GainExplorer
-from rns_viz.live.reach import build_reach_region
+from rns_viz.live.explorer.gain_explorer import AUTHORITY_CHUNK, GainExplorer
+from rns_viz.live.jobs import helper as jobs
+from rns_viz.live.jobs.background import Background, ReachReady
+from rns_viz.live.reach.region import build_reach_region
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_key
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from rns_viz.defaults import KICK_LEVER_M, defaults_for
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
-from rns_viz.viz.base_panel import kick_weights
+from rns_viz.viz.panels.base_panel import kick_weights
 
 PEAK_N = defaults_for("boom7").kick_range_N  # the slider's end (20 N)
 

@@ -9,8 +9,8 @@ from collections.abc import Callable, Iterator
 import numpy as np
 import pytest
 
-from rns_viz.live.lessons import LESSONS
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
+from rns_viz.live.teaching.lessons import LESSONS
 from tests.app_helpers import run_lesson, stepped_session
 
 SIDEWAYS = (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)

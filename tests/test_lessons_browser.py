@@ -22,10 +22,10 @@ from PIL import Image
 from playwright.sync_api import Page
 
 from rns_viz.defaults import defaults_for
-from rns_viz.live.lessons import LESSONS
-from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.ghost import Ghost
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.ghost import Ghost
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import (
     ARTIFACTS,
     browser_marks,

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from rns_viz.control import Gains, InvalidGain, JointSample, TaskSample
-from rns_viz.live import commands as c
-from rns_viz.live.operator import UNCHANGED, InputRefused, Operator
-from rns_viz.live.path_table import build_path_table
-from rns_viz.live.runs import LawChoice, RunPair
+from rns_viz.live.loop import commands as c
+from rns_viz.live.operator.operator import UNCHANGED, InputRefused, Operator
+from rns_viz.live.reach.path_table import build_path_table
+from rns_viz.live.runs.run_pair import LawChoice, RunPair
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.rns import null_vector
@@ -169,7 +169,7 @@ def test_a_kick_reaches_both_runs_alike_without_suppression(trep: FsmsModel) -> 
     theta0 = trep.spec.default_configuration
     runs = RunPair.at_rest("trep", theta0)
     runs.install(LawChoice("acceleration", Gains(g_b=0.0, g_m=2.0), True), JointSample.held(theta0))
-    from rns_viz.live.kicks import kick_pulse
+    from rns_viz.live.runs.kicks import kick_pulse
 
     runs.kick(kick_pulse(0.0, 0.8, 0.1, trep.m))
     for _ in range(200):
@@ -180,7 +180,7 @@ def test_a_kick_reaches_both_runs_alike_without_suppression(trep: FsmsModel) -> 
 
 # ---------------------------------------------------------------- inputs that wait or are moved
 def test_play_right_after_reset_waits_for_the_path_and_then_runs() -> None:
-    from rns_viz.live.session import Session
+    from rns_viz.live.loop.session import Session
 
     s = Session("trep", realtime=False)
     try:

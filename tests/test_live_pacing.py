@@ -8,12 +8,12 @@ from collections.abc import Iterator
 
 import pytest
 
-from rns_viz.live import pacing
-from rns_viz.live.pacing import BEHIND_HOLD_S, RTF_WINDOW_S, SPEEDS, Pacer
+from rns_viz.live.loop import wall_clock as pacing
+from rns_viz.live.loop.wall_clock import BEHIND_HOLD_S, RTF_WINDOW_S, SPEEDS, Pacer
 
 
 class Clock:
-    """Stands in for the ``time`` module inside rns_viz.live.pacing: wall time moves when told."""
+    """Stands in for the ``time`` module inside rns_viz.live.loop.wall_clock: wall time moves when told."""
 
     def __init__(self, now: float = 100.0) -> None:
         self.now = now

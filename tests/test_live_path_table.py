@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.path_table import PathTable, build_path_table
+from rns_viz.live.reach.path_table import PathTable, build_path_table
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector
 

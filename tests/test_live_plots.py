@@ -10,11 +10,11 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from rns_viz.live.plots import PLOT_SERIES
-from rns_viz.live.session import Session
-from rns_viz.viz.app import IDLE_RESTART_S, start_app
-from rns_viz.viz.live_plots import on_off, peaks_html
-from rns_viz.viz.units import si
+from rns_viz.live.loop.session import Session
+from rns_viz.live.published.plot_buffers import PLOT_SERIES
+from rns_viz.viz.panels.live_plots import on_off, peaks_html
+from rns_viz.viz.panels.units import si
+from rns_viz.viz.server.app import IDLE_RESTART_S, start_app
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient
 
@@ -118,7 +118,7 @@ def test_a_preset_can_start_paused() -> None:
 
 def test_a_session_nobody_watched_restarts_for_its_first_visitor(monkeypatch: pytest.MonkeyPatch) -> None:
     assert IDLE_RESTART_S == 60.0
-    monkeypatch.setattr("rns_viz.viz.app.IDLE_RESTART_S", 1.0)  # s: the test runs 2 s, not 61
+    monkeypatch.setattr("rns_viz.viz.server.app.IDLE_RESTART_S", 1.0)  # s: the test runs 2 s, not 61
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         s = app.session

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from rns_viz.live.follower import Follower, ScalarFollower
-from rns_viz.live.guard import MAX_BASE_SPEED, MAX_JOINT_SPEED, Bounds
-from rns_viz.live.kicks import MAX_KICK_N, KickSchedule, kick_pulse
+from rns_viz.live.operator.follower import Follower, ScalarFollower
+from rns_viz.live.runs.divergence_guard import MAX_BASE_SPEED, MAX_JOINT_SPEED, Bounds
+from rns_viz.live.runs.kicks import MAX_KICK_N, KickSchedule, kick_pulse
 from rns_viz.model import FsmsModel
 from rns_viz.sim.disturbance import ForcePulse
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 
 SIDEWAYS = (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)  # a kick along y: the boom's first bending mode
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import tracemalloc
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 
 
 def test_memory_stays_bounded_over_a_long_run() -> None:

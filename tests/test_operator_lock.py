@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from rns_viz.live.operator_lock import LockRefused, OperatorLock
+from rns_viz.live.operator.operator_lock import LockRefused, OperatorLock
 
 
 def test_first_client_operates_and_control_passes_on_in_order_of_arrival() -> None:

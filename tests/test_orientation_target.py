@@ -14,9 +14,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rns_viz.live.operator import orientation_note
-from rns_viz.live.references import ResolvedRate
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
+from rns_viz.live.operator.moving_references import ResolvedRate
+from rns_viz.live.operator.operator import orientation_note
 from rns_viz.model import FsmsModel
 from rns_viz.rns import rns_projector
 
@@ -209,7 +209,7 @@ def test_at_r_5_sigma_jbar_is_the_second_singular_value_and_orientation_is_refus
 
 def test_bad_quaternions_from_a_client_are_told_and_the_simulation_runs_on() -> None:
     """The handle's drag with a NaN or zero quaternion, as a client could send it (tests/protocol_client.py)."""
-    from rns_viz.viz.app import TARGET_HANDLE
+    from rns_viz.viz.server.app import TARGET_HANDLE
     from tests.app_helpers import stepped_app
     from tests.browser import wait_for_clients, wait_until
     from tests.protocol_client import ProtocolClient

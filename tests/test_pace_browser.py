@@ -12,9 +12,9 @@ from collections.abc import Iterator
 import pytest
 from playwright.sync_api import Page
 
-from rns_viz.live.session import Session
-from rns_viz.viz.app import RnsApp
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.live.loop.session import Session
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.server.app import RnsApp
 from tests.app_helpers import realtime_app
 from tests.browser import browser_marks, browser_page, wait_for_nodes, wait_until
 

@@ -16,9 +16,9 @@ import pytest
 from playwright.sync_api import Page
 
 from rns_viz.scenarios import SCENARIOS
-from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.gui import PLANAR3R_PRESETS, TREP_PRESETS
-from rns_viz.viz.live_plots import SCALES
+from rns_viz.viz.panels.control_panel import PLANAR3R_PRESETS, TREP_PRESETS
+from rns_viz.viz.panels.live_plots import SCALES
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import (
     browser_marks,
     browser_page,

@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.rank_view import RANK_HINT, inset_slice, rank_inset
+from rns_viz.live.teaching.rank_view import RANK_HINT, inset_slice, rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.rank import kernel_coupling
-from rns_viz.viz.app import start_app
-from rns_viz.viz.rank_inset import DOT_COLOUR, InsetPicture, dot_pixel, draw_inset, with_dot
+from rns_viz.viz.panels.rank_inset import DOT_COLOUR, InsetPicture, dot_pixel, draw_inset, with_dot
+from rns_viz.viz.server.app import start_app
 from tests.browser import wait_until
 
 PLANES = [("trep", np.array([1.2, -0.4]), 4), ("planar3r", np.array([0.0, 0.5, -1.0]), 4)]

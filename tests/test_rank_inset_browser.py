@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rns_viz.viz.app import start_app
-from rns_viz.viz.rank_inset import SIZE_PX
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.panels.rank_inset import SIZE_PX
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.server.app import start_app
 from tests.browser import (
     ARTIFACTS,
     browser_marks,

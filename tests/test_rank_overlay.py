@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.rank_view import arm_pose, rank_overlay
+from rns_viz.live.teaching.rank_view import arm_pose, rank_overlay
 from rns_viz.model import FsmsModel
 from rns_viz.rank import kernel_coupling
 

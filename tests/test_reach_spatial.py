@@ -12,10 +12,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rns_viz.live.reach import build_reach_region
-from rns_viz.live.reach_spatial import bracket_rank, explore_rns
-from rns_viz.live.readouts import arm_reach
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
+from rns_viz.live.reach.region import arm_reach, build_reach_region
+from rns_viz.live.reach.spatial import bracket_rank, explore_rns
 from rns_viz.model import FsmsModel
 from rns_viz.rns import rns_projector
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import viser
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
 from rns_viz.viz import FsmsScene
 

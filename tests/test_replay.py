@@ -15,11 +15,12 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from rns_viz.live import commands as c
-from rns_viz.live.recorder import MAX_RECORD_S, read_csv
-from rns_viz.live.replay import replay_snapshot
-from rns_viz.live.session import Session
-from rns_viz.viz.app import RnsApp
+from rns_viz.live.loop import commands as c
+from rns_viz.live.loop.replay_mode import replay_snapshot
+from rns_viz.live.loop.session import Session
+from rns_viz.live.outputs.recorder import MAX_RECORD_S
+from rns_viz.live.published.recording import read_csv
+from rns_viz.viz.server.app import RnsApp
 from tests.browser import wait_until
 
 KICKS = {"trep": 0.8, "planar3r": 5.0}

@@ -8,12 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from rns_viz.live.recorder import reaction_columns, read_csv
-from rns_viz.live.records import ReplayView
-from rns_viz.live.replay import replay_snapshot
-from rns_viz.live.session import Session
-from rns_viz.viz import recording as player
-from rns_viz.viz.scene import FsmsScene
+from rns_viz.live.loop.replay_mode import replay_snapshot
+from rns_viz.live.loop.session import Session
+from rns_viz.live.published.recording import reaction_columns, read_csv
+from rns_viz.live.published.snapshot import ReplayView
+from rns_viz.viz.scene import player_export as player
+from rns_viz.viz.scene.fsms_scene import FsmsScene
 
 BOOM7_KICK_N = 5.0  # N: the app's kick, along the tip's y and z
 

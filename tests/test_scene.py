@@ -12,9 +12,9 @@ import viser
 from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family
 from rns_viz.viz import FsmsScene
-from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
-from rns_viz.viz.geometry import Trail, guided_cantilever, path_family_segments, simplify, zigzag
-from rns_viz.viz.scene import PATH_HIGHLIGHT
+from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.scene.fsms_scene import PATH_HIGHLIGHT
+from rns_viz.viz.scene.shapes import Trail, guided_cantilever, path_family_segments, simplify, zigzag
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.readouts import arm_reach
+from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family, reactionless_reachable_set, trace_paths
 from rns_viz.viz import FsmsScene

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 
 
 def put_arm_at(s: Session, theta: list[float]) -> None:

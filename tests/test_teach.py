@@ -12,9 +12,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
-from rns_viz.viz.app import RnsApp, start_app
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import wait_until
 
 
@@ -154,7 +154,7 @@ def test_lesson_panel_starts_steps_and_shows_progress_through_the_protocol() -> 
 
 
 def test_cli_lesson_option_reaches_the_app(monkeypatch: pytest.MonkeyPatch) -> None:
-    import rns_viz.viz.app as app_module
+    import rns_viz.viz.server.app as app_module
     from rns_viz import cli
 
     calls: list[dict[str, object]] = []
@@ -166,7 +166,7 @@ def test_cli_lesson_option_reaches_the_app(monkeypatch: pytest.MonkeyPatch) -> N
 
 
 def test_path_words_turn_ubar_into_joint_angles_and_rates() -> None:
-    from rns_viz.viz.path_words import path_words
+    from rns_viz.viz.panels.path_words import path_words
 
     s = Session("trep", realtime=False)
     try:

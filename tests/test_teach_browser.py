@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 from playwright.sync_api import sync_playwright
 
-from rns_viz.viz.app import RnsApp, start_app
-from rns_viz.viz.ghost import Ghost
-from rns_viz.viz.recording import PLAYER_URL, RECORDING_NAME
-from rns_viz.viz.scene import FsmsScene
-from rns_viz.viz.teach_scene import TeachScene
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.ghost import Ghost
+from rns_viz.viz.scene.player_export import PLAYER_URL, RECORDING_NAME
+from rns_viz.viz.scene.teach_scene import TeachScene
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser import (
     ARTIFACTS,
     CHROMIUM,

@@ -1,5 +1,12 @@
-"""The live session (no viser): :mod:`rns_viz.live.session` is the boundary other threads call;
-typed commands (:mod:`~rns_viz.live.commands`) are applied by the loop-owned
-:class:`~rns_viz.live.state.LiveState`, which holds the run pair (:mod:`~rns_viz.live.runs`), the
-operator and its references (:mod:`~rns_viz.live.operator`, :mod:`~rns_viz.live.references`),
-background geometry (:mod:`~rns_viz.live.background`) and what is published (:mod:`~rns_viz.live.outputs`)."""
+"""The live session (no viser), in layers: each subpackage imports only those below it (import-linter
+checks it, pyproject.toml's ``live-layers`` contract).
+
+- :mod:`~rns_viz.live.loop`: the session other threads call, and the one loop that owns the state;
+- :mod:`~rns_viz.live.teaching`, :mod:`~rns_viz.live.explorer`, :mod:`~rns_viz.live.outputs`: lessons,
+  the gain explorer, and what is booked after every step (plots, readouts, reaction, recorder);
+- :mod:`~rns_viz.live.runs`: the operated run and its shadow, their laws, kicks and divergence guard;
+- :mod:`~rns_viz.live.operator` and :mod:`~rns_viz.live.jobs`: what the operator drives (references,
+  targets, the operator lock), and slow work off the loop (worker thread, helper process);
+- :mod:`~rns_viz.live.reach` and :mod:`~rns_viz.live.published`: where the arm can go without reaction,
+  and the immutable records readers take (snapshot, recording, plot buffers).
+"""

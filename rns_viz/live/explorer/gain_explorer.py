@@ -31,9 +31,9 @@ from rns_viz.analysis import (
     root_locus,
 )
 from rns_viz.control import Gains, LawKind
-from rns_viz.live import jobs
-from rns_viz.live.dual import dual_by_name
-from rns_viz.live.worker import Worker
+from rns_viz.live.jobs import helper as jobs
+from rns_viz.live.jobs.worker import Worker
+from rns_viz.live.operator.dual_arm import dual_by_name
 from rns_viz.sim import Simulator
 
 AUTHORITY_POINTS = 80  # configurations along the path / over the set where the decay is predicted

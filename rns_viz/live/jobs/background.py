@@ -1,7 +1,7 @@
 """The live session's slow work: path tables, reachable sets, path families and preset builds.
 
 :class:`Background` submits each request to the worker thread (which runs the geometry in a helper
-process, :mod:`rns_viz.live.jobs`) tagged with the loop's epoch, and hands back typed results of the
+process, :mod:`rns_viz.live.jobs.helper`) tagged with the loop's epoch, and hands back typed results of the
 current epoch only: a result computed for a model or preset that has since been left is dropped here.
 """
 
@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.live import jobs
-from rns_viz.live.path_table import PathTable
-from rns_viz.live.reach import ReachRegion
-from rns_viz.live.worker import Worker
+from rns_viz.live.jobs import helper as jobs
+from rns_viz.live.jobs.worker import Worker
+from rns_viz.live.reach.path_table import PathTable
+from rns_viz.live.reach.region import ReachRegion
 from rns_viz.scenarios import LIVE_SCENARIOS
 from rns_viz.sim import Simulator
 

@@ -2,7 +2,7 @@
 
 A Python-heavy computation in a thread would take turns with the simulation thread for the GIL
 and slow it down; a separate process runs beside it on another core. The helper is
-``python -m rns_viz.live.jobs`` (a plain subprocess, so no caller needs a ``__main__`` guard),
+``python -m rns_viz.live.jobs.helper`` (a plain subprocess, so no caller needs a ``__main__`` guard),
 speaking length-prefixed pickles over its stdin and stdout. :func:`call` runs one job there,
 blocking the calling thread (not the GIL) until the result is back; the helper is started on
 first use, restarted if it died, and shared by all sessions of the process.
@@ -10,7 +10,7 @@ first use, restarted if it died, and shared by all sessions of the process.
 One helper runs one job at a time. The gain explorer's linearisations (:data:`BACKGROUND_JOBS`) yield
 to every other job: a caller of those waits while one of the others waits, so a reachable set asked
 for after a change of S waits for at most the one explorer call in flight (the explorer cuts its
-sweep over a path into calls of a few configurations, rns_viz.live.gain_explorer).
+sweep over a path into calls of a few configurations, rns_viz.live.explorer.gain_explorer).
 
 Jobs are the top-level functions below: plain arguments, picklable results. Each is a function of its
 arguments (and the model file), so the helper answers a request it has already answered from its
@@ -32,8 +32,8 @@ import numpy as np
 
 from rns_viz.analysis import GainMap, LinearLoop, linearise, loops_along, map_of
 from rns_viz.control import LawKind
-from rns_viz.live.path_table import PathTable, build_path_table
-from rns_viz.live.reach import ReachRegion, build_reach_region
+from rns_viz.live.reach.path_table import PathTable, build_path_table
+from rns_viz.live.reach.region import ReachRegion, build_reach_region
 from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family
 
@@ -149,7 +149,7 @@ class _Helper:
     def _running(self) -> subprocess.Popen[bytes]:
         if self.proc is None or self.proc.poll() is not None:
             self.proc = subprocess.Popen(
-                [sys.executable, "-m", "rns_viz.live.jobs"], stdin=subprocess.PIPE, stdout=subprocess.PIPE
+                [sys.executable, "-m", "rns_viz.live.jobs.helper"], stdin=subprocess.PIPE, stdout=subprocess.PIPE
             )
         return self.proc
 

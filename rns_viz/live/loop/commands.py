@@ -3,7 +3,7 @@
 Constructing a command is the one place its input is checked: ``__post_init__`` raises a
 ``ValueError`` (:class:`~rns_viz.control.InvalidGain` for gains) with a message for the user, and
 nothing is queued. The loop applies a command with a ``match`` on its type
-(:meth:`rns_viz.live.state.LiveState.apply`), so "go to definition" leads from an input to its effect.
+(:meth:`rns_viz.live.loop.state.LiveState.apply`), so "go to definition" leads from an input to its effect.
 Every command carries the client that sent it (for replies) and when it arrived (for latency).
 """
 
@@ -18,9 +18,9 @@ from typing import Any
 import numpy as np
 
 from rns_viz.control import Gains, InvalidGain, LawKind
-from rns_viz.live.lessons import LESSONS
-from rns_viz.live.pacing import SPEEDS
-from rns_viz.live.recorder import MAX_RECORD_S
+from rns_viz.live.loop.wall_clock import SPEEDS
+from rns_viz.live.outputs.recorder import MAX_RECORD_S
+from rns_viz.live.teaching.lessons import LESSONS
 from rns_viz.params import check_model_key
 from rns_viz.scenarios import LIVE_SCENARIOS
 
@@ -282,7 +282,7 @@ class StopLesson(Command):
 
 @dataclass(frozen=True)
 class ReplayCommand(Command):
-    """The replay's inputs (:mod:`rns_viz.live.replay` applies them); any other input ends a replay first."""
+    """The replay's inputs (:mod:`rns_viz.live.loop.replay_mode` applies them); any other input ends a replay first."""
 
 
 @dataclass(frozen=True)

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.live.guard import Bounds
-from rns_viz.live.operator import InputRefused
-from rns_viz.live.readouts import arm_reach
+from rns_viz.live.operator.operator import InputRefused
+from rns_viz.live.reach.region import arm_reach
+from rns_viz.live.runs.divergence_guard import Bounds
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_key, model_source, spec_for_key
 from rns_viz.paths import CouplingField

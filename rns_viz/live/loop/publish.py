@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from rns_viz.live.operator import Operator
-from rns_viz.live.outputs import Outputs
-from rns_viz.live.records import LessonStatus, ReplayView, Settings, Snapshot
-from rns_viz.live.runs import RunPair
+from rns_viz.live.operator.operator import Operator
+from rns_viz.live.outputs.step_outputs import Outputs
+from rns_viz.live.published.snapshot import LessonStatus, ReplayView, Settings, Snapshot
+from rns_viz.live.runs.run_pair import RunPair
 
 
 def make_snapshot(

@@ -1,12 +1,13 @@
 """Replay: a mode of the live session in which the simulation waits and a recording is shown instead.
 
 The loop applies the replay commands (:func:`apply_replay`, called by
-:meth:`rns_viz.live.state.LiveState.apply`): *start* takes the newest N seconds from the recorder
-(:mod:`rns_viz.live.recorder`) into an immutable :class:`~rns_viz.live.records.ReplayView` and pauses
-the simulation; *seek*, *speed* and *play/pause* make a new view; *stop*, or any other input, goes back
-to live with the simulation as it was (running again if it ran). Readers turn the view into the
-snapshot they draw with :func:`replay_snapshot`, so the arm, ghost, overlays and plots are drawn by
-the same code as live, from the recorded states.
+:meth:`rns_viz.live.loop.state.LiveState.apply`): *start* takes the newest N seconds from the recorder
+(:mod:`rns_viz.live.outputs.recorder`) into an immutable
+:class:`~rns_viz.live.published.snapshot.ReplayView` and pauses the simulation; *seek*, *speed* and
+*play/pause* make a new view; *stop*, or any other input, goes back to live with the simulation as it
+was (running again if it ran). Readers turn the view into the snapshot they draw with
+:func:`replay_snapshot`, so the arm, ghost, overlays and plots are drawn by the same code as live, from
+the recorded states.
 """
 
 from __future__ import annotations
@@ -15,20 +16,20 @@ import time
 from dataclasses import replace
 from typing import Protocol
 
-from rns_viz.live import commands as c
-from rns_viz.live.operator import InputRefused
-from rns_viz.live.outputs import Outputs
-from rns_viz.live.pacing import Pacer
-from rns_viz.live.recorder import Recording
-from rns_viz.live.records import ReplayView, Snapshot
-from rns_viz.live.runs import RunPair
+from rns_viz.live.loop import commands as c
+from rns_viz.live.loop.wall_clock import Pacer
+from rns_viz.live.operator.operator import InputRefused
+from rns_viz.live.outputs.step_outputs import Outputs
+from rns_viz.live.published.recording import Recording
+from rns_viz.live.published.snapshot import ReplayView, Snapshot
+from rns_viz.live.runs.run_pair import RunPair
 from rns_viz.model import FsmsModel
 
 SEEK_SLACK_S = 0.01  # s: a seek this close outside the recording goes to its end (the timeline's resolution)
 
 
 class ReplayHost(Protocol):
-    """What the replay touches of the loop's state (:class:`~rns_viz.live.state.LiveState`)."""
+    """What the replay touches of the loop's state (:class:`~rns_viz.live.loop.state.LiveState`)."""
 
     paused: bool
     replay: ReplayView | None
@@ -88,7 +89,7 @@ def _back_to_live(state: ReplayHost, view: ReplayView) -> None:
 
 
 def readout_row(rec: Recording) -> int:
-    """The base row the reaction readout shows: the first selected one (as rns_viz.live.outputs)."""
+    """The base row the reaction readout shows: the first selected one (as rns_viz.live.outputs.step_outputs)."""
     return int(rec.model.selected[0])
 
 

@@ -1,14 +1,14 @@
 """The live session: one loop owns the simulation; every other thread only sends commands.
 
 A :class:`Session` runs the operated run and a *shadow* run that receives the same operator inputs
-and kicks with vibration suppression the other way (:mod:`rns_viz.live.runs`), paced to the wall
+and kicks with vibration suppression the other way (:mod:`rns_viz.live.runs.run_pair`), paced to the wall
 clock at a chosen speed (1/8x to 2x), with slow geometry in the background
-(:mod:`rns_viz.live.background`).
+(:mod:`rns_viz.live.jobs.background`).
 
 The path of an input: a GUI callback calls a public method here, which builds the typed command
-(:mod:`rns_viz.live.commands`; its constructor is the one check, raising ``ValueError`` at once,
+(:mod:`rns_viz.live.loop.commands`; its constructor is the one check, raising ``ValueError`` at once,
 nothing queued) and queues it; the loop thread applies it between two steps
-(:meth:`rns_viz.live.state.LiveState.apply`). Readers take :meth:`snapshot`, :meth:`plot_arrays`,
+(:meth:`rns_viz.live.loop.state.LiveState.apply`). Readers take :meth:`snapshot`, :meth:`plot_arrays`,
 :meth:`overlays` and :meth:`pop_notices`. Nothing here imports viser.
 
 ``Session(realtime=False)`` has no loop thread: the caller drives it with :meth:`advance`
@@ -26,13 +26,13 @@ from typing import Any
 
 import numpy as np
 
-from rns_viz.live import commands as c
-from rns_viz.live.gain_explorer import GainView
-from rns_viz.live.pacing import MAX_BACKLOG_S, SPEEDS, Pacer
-from rns_viz.live.plots import PlotBuffers
-from rns_viz.live.recorder import Recording
-from rns_viz.live.records import Notice, Overlays, Snapshot
-from rns_viz.live.state import LiveState
+from rns_viz.live.explorer.gain_explorer import GainView
+from rns_viz.live.loop import commands as c
+from rns_viz.live.loop.state import LiveState
+from rns_viz.live.loop.wall_clock import MAX_BACKLOG_S, SPEEDS, Pacer
+from rns_viz.live.published.plot_buffers import PlotBuffers
+from rns_viz.live.published.recording import Recording
+from rns_viz.live.published.snapshot import Notice, Overlays, Snapshot
 from rns_viz.params import check_model_key
 from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S
 

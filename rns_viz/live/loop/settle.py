@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from rns_viz.control import LawKind
-from rns_viz.live.operator import Operator
+from rns_viz.live.operator.operator import Operator
 from rns_viz.paths import CouplingField
 from rns_viz.sim import Simulator
 

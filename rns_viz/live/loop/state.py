@@ -1,5 +1,5 @@
 """The state of a live session, owned by its simulation loop: one object, touched by one thread. The loop
-calls :meth:`LiveState.apply` per command (a ``match``; replay's in live/replay.py), :meth:`tick` per step,
+calls :meth:`LiveState.apply` per command (a ``match``; replay's in live/loop/replay_mode.py), :meth:`tick` per step,
 :meth:`collect` for background results; :meth:`publish` makes the snapshot readers take. No viser here."""
 
 from __future__ import annotations
@@ -12,24 +12,24 @@ import numpy as np
 
 from rns_viz.control import Gains, LawKind
 from rns_viz.defaults import defaults_for
-from rns_viz.live import commands as c
-from rns_viz.live.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
-from rns_viz.live.dual import refuse_other_laws
-from rns_viz.live.gain_explorer import GainExplorer
-from rns_viz.live.geometry import Geometry
-from rns_viz.live.guard import GUARD_EVERY
-from rns_viz.live.kicks import kick_pulse
-from rns_viz.live.lesson_run import OBSERVE_EVERY, LessonRun, run_view
-from rns_viz.live.loop_model import LoopModel, key_of, selection_key
-from rns_viz.live.operator import InputRefused, Operator, PathNotReady
-from rns_viz.live.outputs import Outputs
-from rns_viz.live.pacing import Pacer
-from rns_viz.live.path_table import PathTable
-from rns_viz.live.records import Level, Notice, ReplayView, Settings, Snapshot
-from rns_viz.live.replay import apply_replay
-from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
-from rns_viz.live.settle import settled_elsewhere
-from rns_viz.live.snapshot import make_snapshot
+from rns_viz.live.explorer.gain_explorer import GainExplorer
+from rns_viz.live.jobs.background import Background, FamilyReady, JobFailed, PresetReady, ReachReady, TableReady
+from rns_viz.live.loop import commands as c
+from rns_viz.live.loop.loop_model import LoopModel, key_of, selection_key
+from rns_viz.live.loop.publish import make_snapshot
+from rns_viz.live.loop.replay_mode import apply_replay
+from rns_viz.live.loop.settle import settled_elsewhere
+from rns_viz.live.loop.shown_geometry import Geometry
+from rns_viz.live.loop.wall_clock import Pacer
+from rns_viz.live.operator.dual_arm import refuse_other_laws
+from rns_viz.live.operator.operator import InputRefused, Operator, PathNotReady
+from rns_viz.live.outputs.step_outputs import Outputs
+from rns_viz.live.published.snapshot import Level, Notice, ReplayView, Settings, Snapshot
+from rns_viz.live.reach.path_table import PathTable
+from rns_viz.live.runs.divergence_guard import GUARD_EVERY
+from rns_viz.live.runs.kicks import kick_pulse
+from rns_viz.live.runs.run_pair import LawChoice, RunPair, ShadowDiverged
+from rns_viz.live.teaching.lesson_run import OBSERVE_EVERY, LessonRun, run_view
 from rns_viz.model import FsmsModel
 from rns_viz.scenarios import LIVE_SCENARIOS
 
@@ -48,7 +48,7 @@ class LiveState:
         self.epoch = self.settings_version = self.target_version = 0
         self.paused = False
         self.diverged: str | None = None
-        self.replay: ReplayView | None = None  # a replay shown while the simulation waits (live/replay.py)
+        self.replay: ReplayView | None = None  # a replay shown while the simulation waits (live/loop/replay_mode.py)
         self.settings = Settings.defaults(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
         self.lesson: LessonRun | None = None

@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from rns_viz.control import ControlOutput, Gains, TaskSample
 from rns_viz.control.compensation import CompensatingLaw
-from rns_viz.live.smoothed_target import SmoothedTarget
+from rns_viz.live.operator.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 
 WORKSPACE_MARGIN = 0.03  # fraction of the task arm's reach kept clear of its outer and inner boundary

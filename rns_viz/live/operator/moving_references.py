@@ -1,6 +1,6 @@
 """References the operator moves while the simulation runs; the session advances them once per step.
 
-The operator (rns_viz.live.operator) advances them once *before* the step at time t and hands
+The operator (rns_viz.live.operator.operator) advances them once *before* the step at time t and hands
 immutable samples of them to both runs' laws, so the shadow sees the same operator inputs.
 
 - :class:`SigmaMotion`: sigma = integral of u-bar dt (Eq. 30) held, driven to a goal (scrub, drag),
@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from rns_viz.live.follower import ScalarFollower
-from rns_viz.live.smoothed_target import SmoothedTarget
+from rns_viz.live.operator.follower import ScalarFollower
+from rns_viz.live.operator.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic

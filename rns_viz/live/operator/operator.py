@@ -14,7 +14,7 @@ reachable set and followed by the :class:`ResolvedRate` reference; in space with
 orientation too, as a secondary task (the laws (15)/(16) then follow theta_ref, see :meth:`Operator.law_task`).
 
 Dual arms (trep2): the target is clamped to the task arm's workspace and followed by the task arm
-(:class:`~rns_viz.live.dual.TaskTarget`); the compensating arm cancels the reaction.
+(:class:`~rns_viz.live.operator.dual_arm.TaskTarget`); the compensating arm cancels the reaction.
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ import numpy as np
 import pinocchio as pin
 
 from rns_viz.control import JointSample, TaskSample
-from rns_viz.live.dual import TaskTarget, is_dual
-from rns_viz.live.path_table import PathTable
-from rns_viz.live.reach import ReachRegion
-from rns_viz.live.records import OrientationView
-from rns_viz.live.references import PathFollower, ResolvedRate, SigmaMotion
+from rns_viz.live.operator.dual_arm import TaskTarget, is_dual
+from rns_viz.live.operator.moving_references import PathFollower, ResolvedRate, SigmaMotion
+from rns_viz.live.published.snapshot import OrientationView
+from rns_viz.live.reach.path_table import PathTable
+from rns_viz.live.reach.region import ReachRegion
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import QuinticSegment
 from rns_viz.scenarios import FIG11_FAST_S

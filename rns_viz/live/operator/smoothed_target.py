@@ -1,6 +1,6 @@
-"""The operator's target smoothed by a :class:`~rns_viz.live.follower.Follower`: the state shared by the
-planar 3R's reactionless resolved-rate reference (:class:`~rns_viz.live.references.ResolvedRate`) and
-trep2's task-arm target (:class:`~rns_viz.live.dual.TaskTarget`), reset in one place.
+"""The operator's target smoothed by a :class:`~rns_viz.live.operator.follower.Follower`: the state shared by the
+planar 3R's reactionless resolved-rate reference (:class:`~rns_viz.live.operator.moving_references.ResolvedRate`) and
+trep2's task-arm target (:class:`~rns_viz.live.operator.dual_arm.TaskTarget`), reset in one place.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from rns_viz.live.follower import Follower
+from rns_viz.live.operator.follower import Follower
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 

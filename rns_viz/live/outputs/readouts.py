@@ -1,4 +1,4 @@
-"""Readouts of the live session: distances to singularity, the null-space vector, the arm's reach."""
+"""Readouts of the live session: distances to singularity, the null-space vector."""
 
 from __future__ import annotations
 
@@ -6,17 +6,10 @@ from functools import cache
 
 import numpy as np
 
-from rns_viz.live.dual import compensator_sigmas, is_dual
-from rns_viz.live.records import Readouts
+from rns_viz.live.operator.dual_arm import compensator_sigmas, is_dual
+from rns_viz.live.published.snapshot import Readouts
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector, rns_projector, truncated_inverse
-
-
-def arm_reach(model: FsmsModel) -> float:
-    """Arm reach (m): joint-to-joint distances plus the end-effector offset."""
-    pm = model.pin_model
-    links = sum(float(np.linalg.norm(pm.jointPlacements[j].translation)) for j in range(model.m + 2, pm.njoints))
-    return links + float(np.linalg.norm(pm.frames[model.ee_frame_id].placement.translation))
 
 
 def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:

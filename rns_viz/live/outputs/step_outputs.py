@@ -1,7 +1,7 @@
 """What the live session publishes from the runs: plot samples, readouts and the arm's reaction.
 
 :class:`Outputs` is fed by the simulation loop after every step and read by any thread through the
-plot buffers and the latest :class:`~rns_viz.live.records.Readouts`. Units: the plots carry x_b in
+plot buffers and the latest :class:`~rns_viz.live.published.snapshot.Readouts`. Units: the plots carry x_b in
 mm, L in kg m/s and the end-effector error in mm; readouts are SI.
 """
 
@@ -14,13 +14,13 @@ from dataclasses import replace
 import numpy as np
 
 from rns_viz.control import ControlOutput
-from rns_viz.live.dual import compensation_state, operated_is_better
-from rns_viz.live.plots import BASE_COORDINATES, PlotBuffers
-from rns_viz.live.reaction import ReactionProbe
-from rns_viz.live.readouts import compute_readouts
-from rns_viz.live.recorder import Recorder
-from rns_viz.live.records import Readouts
-from rns_viz.live.runs import RunPair
+from rns_viz.live.operator.dual_arm import compensation_state, operated_is_better
+from rns_viz.live.outputs.reaction import ReactionProbe
+from rns_viz.live.outputs.readouts import compute_readouts
+from rns_viz.live.outputs.recorder import Recorder
+from rns_viz.live.published.plot_buffers import BASE_COORDINATES, PlotBuffers
+from rns_viz.live.published.snapshot import Readouts
+from rns_viz.live.runs.run_pair import RunPair
 from rns_viz.model import FsmsModel
 
 PLOT_EVERY = 20  # steps between plot samples (50 Hz: a 10 s window is 500 samples)

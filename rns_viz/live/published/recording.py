@@ -1,17 +1,12 @@
-"""Always-on recording of the last minute of a live session, and the immutable recordings taken from it.
+"""The immutable recordings taken from the live session's recorder, and their CSV.
 
-:class:`Recorder` is fed by the simulation loop after every 1 ms step (through
-:class:`~rns_viz.live.outputs.Outputs`) and keeps the newest :data:`MAX_RECORD_S` seconds in one
-preallocated ring buffer: per step, the operated run's step-log row (t, x_b, x_b', θ, θ', τ, the
-base force, L, the distances to singularity and the law's references θ_ref / x_ref, exactly the
-floats of the simulation log), the shadow run's state, L and τ at the same t, the arm's reaction on
-the base (Eq. 1) as the readout showed it (every base row: the wrench a 6-DOF base draws as arrows)
-and whether suppression was on. Always on because it costs
-one row copy per step (about 2 µs: 0.2 % of one core) and 60 s of TREP fill 15 MB (3R: 18 MB);
-it restarts with the run (reset, model switch, preset load), so a recording never spans two systems.
-
-:meth:`Recorder.take` copies the newest N seconds into a :class:`Recording`: read-only arrays that any
-thread may replay, plot or export (CSV with units in the header, reading back bit-exact).
+:meth:`~rns_viz.live.outputs.recorder.Recorder.take` copies the newest N seconds of the ring buffer into a
+:class:`Recording`: read-only arrays that any thread may replay, plot or export (CSV with units in the
+header, reading back bit-exact). Per step it holds the operated run's step-log row (t, x_b, x_b', θ, θ', τ,
+the base force, L, the distances to singularity and the law's references θ_ref / x_ref, exactly the floats
+of the simulation log), the shadow run's state, L and τ at the same t, the arm's reaction on the base
+(Eq. 1) as the readout showed it (every base row: the wrench a 6-DOF base draws as arrows) and whether
+suppression was on.
 """
 
 from __future__ import annotations
@@ -24,12 +19,10 @@ from functools import cached_property
 
 import numpy as np
 
-from rns_viz.live.plots import PLOT_SERIES
-from rns_viz.live.runs import RunPair
+from rns_viz.live.published.plot_buffers import PLOT_SERIES
 from rns_viz.model import FsmsModel
 from rns_viz.sim.log import write_csv_rows
 
-MAX_RECORD_S = 60.0  # s of simulated time kept
 PLOT_WINDOW_S = 10.0  # s: the live plots' window, replayed alike
 PLOT_EVERY = 20  # steps between replayed plot samples (50 Hz, as live)
 SUPPRESS = "suppress"  # 1.0 while the operated run had suppression on
@@ -57,7 +50,6 @@ _UNITS = {
     "reaction": "N",
     "suppress": "1 = on",
 }
-_SHADOW = ("xb", "xbdot", "theta", "thetadot", "L", "tau")  # the shadow run's columns kept (prefixes)
 
 
 def column_unit(name: str, rotational_base: bool = False) -> str:
@@ -240,79 +232,7 @@ def read_csv(data: bytes) -> tuple[list[str], np.ndarray]:
     return header, rows.reshape(-1, len(header))
 
 
-class Recorder:
-    """The ring buffer of the newest MAX_RECORD_S seconds of steps; only the loop thread writes it."""
-
-    def __init__(self, seconds: float = MAX_RECORD_S) -> None:
-        self.seconds = seconds
-        self._data: np.ndarray | None = None
-        self.columns: tuple[str, ...] = ()
-        self.restart()
-
-    def restart(self) -> None:
-        """Forget the steps (a new run); the buffer is kept for a run of the same shape."""
-        self._next = self._count = 0
-        self._configured = False
-
-    def _configure(self, runs: RunPair) -> None:
-        log = runs.sim.log
-        # The shadow's columns kept: two contiguous runs of its log row (state and torque; L), cheap to copy.
-        i = log.index
-        n, r = runs.model.n, len(runs.model.selected)
-        self._shadow_blocks = (slice(1, i["tau_1"] + n), slice(i["L_1"], i["L_1"] + r))
-        shadow_names = [c for block in self._shadow_blocks for c in log.columns[block]]
-        assert all(c.rsplit("_", 1)[0] in _SHADOW for c in shadow_names)
-        extra = (*reaction_columns(runs.model.m), SUPPRESS)
-        self._extra = len(extra)
-        columns = (*log.columns, *(f"shadow_{c}" for c in shadow_names), *extra)
-        self._log_width = w = len(log.columns)
-        self._shadow_into = (slice(w, w + i["tau_1"] + n - 1), slice(w + i["tau_1"] + n - 1, len(columns) - len(extra)))
-        capacity = round(self.seconds / runs.sim.dt)
-        if self._data is None or columns != self.columns or len(self._data) != capacity:
-            self._data = np.full((capacity, len(columns)), np.nan)
-        self.columns, self.dt, self._configured = columns, runs.sim.dt, True
-
-    def nbytes(self) -> int:
-        """Memory held by the buffer, bytes."""
-        return 0 if self._data is None else self._data.nbytes
-
-    def __len__(self) -> int:
-        return self._count
-
-    def append(self, runs: RunPair, shadow_on: bool, wrench: tuple[float, ...], suppress: bool) -> None:
-        """Book the step just taken: the newest log rows of both runs (state at the step's start t) and
-        the reaction's base rows as last evaluated (``wrench``, m floats; () before the first: NaN)."""
-        row_log = runs.sim.log.newest()
-        if row_log is None:
-            return
-        if not self._configured:
-            self._configure(runs)
-        data = self._data
-        assert data is not None
-        row = data[self._next]
-        row[: self._log_width] = row_log
-        (state, coupling), (state_to, coupling_to) = self._shadow_blocks, self._shadow_into
-        shadow = runs.shadow.log.newest() if shadow_on else None
-        if shadow is not None and shadow[0] == row_log[0]:
-            row[state_to] = shadow[state]
-            row[coupling_to] = shadow[coupling]
-        else:
-            row[state_to.start : coupling_to.stop] = np.nan
-        row[-self._extra : -1] = wrench if len(wrench) == self._extra - 1 else np.nan
-        row[-1] = 1.0 if suppress else 0.0
-        self._next = (self._next + 1) % len(data)
-        self._count = min(self._count + 1, len(data))
-
-    def take(self, seconds: float, model: FsmsModel) -> Recording | None:
-        """The newest ``seconds`` of steps as an immutable :class:`Recording` (None if under two steps)."""
-        if self._data is None or self._count < 2:
-            return None
-        k = min(self._count, max(2, round(seconds / self.dt)))
-        rows = self._data[(self._next - k + np.arange(k)) % len(self._data)]  # a copy
-        return Recording(self.columns, rows, model, self.dt)
-
-
 def _plotted(columns: np.ndarray) -> np.ndarray:
     """What the live plots show of a block of coordinates (rows x k): the one column, or the length of the
-    first three (a base's translation, the linear momentum), as rns_viz.live.outputs plots it live."""
+    first three (a base's translation, the linear momentum), as rns_viz.live.outputs.step_outputs plots it live."""
     return columns[:, 0] if columns.shape[1] == 1 else np.sqrt(np.sum(columns[:, :3] ** 2, axis=1))

@@ -13,7 +13,7 @@ import numpy as np
 
 from rns_viz.control import Gains, LawKind
 from rns_viz.defaults import defaults_for
-from rns_viz.live.recorder import Recording
+from rns_viz.live.published.recording import Recording
 
 Level = Literal["info", "warning", "error"]
 UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)

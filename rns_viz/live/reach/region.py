@@ -1,8 +1,8 @@
-"""Where a target may go: the reactionless reachable set as a point cloud, and clamping to it.
+"""Where a target may go: the arm's reach, the reactionless reachable set as a point cloud, and clamping to it.
 
 A translating base (the planar 3R) is explored on the level set of its coupling potential
 (:func:`rns_viz.paths.reactionless_reachable_set`); a base that turns (boom7 with r <= 4) by integrating
-the RNS distribution (:mod:`rns_viz.live.reach_spatial`), which also says whether it is involutive.
+the RNS distribution (:mod:`rns_viz.live.reach.spatial`), which also says whether it is involutive.
 """
 
 from __future__ import annotations
@@ -11,10 +11,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.live.reach_spatial import bracket_rank, explore_rns
-from rns_viz.live.readouts import arm_reach
+from rns_viz.live.reach.spatial import bracket_rank, explore_rns
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField, reactionless_reachable_set
+
+
+def arm_reach(model: FsmsModel) -> float:
+    """Arm reach (m): joint-to-joint distances plus the end-effector offset."""
+    pm = model.pin_model
+    links = sum(float(np.linalg.norm(pm.jointPlacements[j].translation)) for j in range(model.m + 2, pm.njoints))
+    return links + float(np.linalg.norm(pm.frames[model.ee_frame_id].placement.translation))
 
 
 @dataclass(frozen=True)

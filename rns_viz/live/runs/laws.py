@@ -31,7 +31,7 @@ from rns_viz.control import (
     TrackJointReference,
     VelocityLaw,
 )
-from rns_viz.live.dual import dual_law, is_dual
+from rns_viz.live.operator.dual_arm import dual_law, is_dual
 from rns_viz.model import FsmsModel
 
 LAW_LABELS: dict[LawKind, str] = {
@@ -65,7 +65,7 @@ def build_law(
 ) -> LiveLaw:
     """A live law; a ``task`` sample selects Eq. (24) tracking for (15)/(16); ``joint_move`` the servo.
 
-    A dual-arm model (:mod:`rns_viz.live.dual`) runs the compensating law whatever ``kind`` (the
+    A dual-arm model (:mod:`rns_viz.live.operator.dual_arm`) runs the compensating law whatever ``kind`` (the
     operator's law choice is refused there), its compensator held still in the ``shadow`` run.
     """
     if is_dual(model):

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.control import ControlOutput, Gains, JointSample, LawKind, TaskSample
-from rns_viz.live.dual import flip_compensation, rehold
-from rns_viz.live.guard import Bounds
-from rns_viz.live.kicks import KickSchedule
-from rns_viz.live.laws import LiveLaw, build_law
+from rns_viz.live.operator.dual_arm import flip_compensation, rehold
+from rns_viz.live.runs.divergence_guard import Bounds
+from rns_viz.live.runs.kicks import KickSchedule
+from rns_viz.live.runs.laws import LiveLaw, build_law
 from rns_viz.model import FsmsModel
 from rns_viz.sim import ForcePulse, Simulator
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
-from rns_viz.live.lessons import LESSONS, Check, Lesson, RunView
-from rns_viz.live.operator import Operator
-from rns_viz.live.records import LessonStatus
-from rns_viz.live.runs import RunPair
+from rns_viz.live.operator.operator import Operator
+from rns_viz.live.published.snapshot import LessonStatus
+from rns_viz.live.runs.run_pair import RunPair
+from rns_viz.live.teaching.lessons import LESSONS, Check, Lesson, RunView
 from rns_viz.model import FsmsModel
 
 OBSERVE_EVERY = 10  # steps between observations (10 ms)

@@ -1,7 +1,7 @@
 """What every lesson is made of: the run a check sees (:class:`RunView`), the check itself and what it
 reports, and the lesson (text, the paper's equation, the state it loads, its check). Nothing here
-imports viser; the lessons themselves are in :mod:`rns_viz.live.lessons` and
-:mod:`rns_viz.live.lessons_boom`.
+imports viser; the lessons themselves are in :mod:`rns_viz.live.teaching.lessons` and
+:mod:`rns_viz.live.teaching.lessons_boom`.
 """
 
 from __future__ import annotations

@@ -13,8 +13,8 @@ from collections import deque
 
 import numpy as np
 
-from rns_viz.live.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
-from rns_viz.live.lessons_boom import BOOM7_LESSONS
+from rns_viz.live.teaching.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
+from rns_viz.live.teaching.lessons_boom import BOOM7_LESSONS
 
 
 class KickAndSwing(Check):

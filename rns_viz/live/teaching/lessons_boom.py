@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from rns_viz.live.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
+from rns_viz.live.teaching.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
 
 TRANSLATIONS, ROTATIONS = slice(0, 3), slice(3, 6)  # x_b = (x, y, z in m; rx, ry, rz in rad)
 

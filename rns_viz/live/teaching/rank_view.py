@@ -16,7 +16,7 @@ from functools import cache
 import numpy as np
 import pinocchio as pin
 
-from rns_viz.live.dual import is_dual
+from rns_viz.live.operator.dual_arm import is_dual
 from rns_viz.model import FsmsModel
 from rns_viz.rank import rank_deficient_configurations, sigma_grid
 

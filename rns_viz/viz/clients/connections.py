@@ -1,6 +1,6 @@
 """Who is connected and who may operate: the operator lock, the password modal and notifications.
 
-Every browser sees the same simulation; the :class:`~rns_viz.live.operator_lock.OperatorLock`
+Every browser sees the same simulation; the :class:`~rns_viz.live.operator.operator_lock.OperatorLock`
 decides whose inputs count. The server itself (client ``None``) may always operate.
 """
 
@@ -10,8 +10,8 @@ from contextlib import suppress
 
 import viser
 
-from rns_viz.live.operator_lock import OperatorLock
-from rns_viz.viz.operator_panel import OperatorPanels
+from rns_viz.live.operator.operator_lock import OperatorLock
+from rns_viz.viz.clients.operator_panel import OperatorPanels
 
 NOTICE_COLOURS = {"info": "blue", "warning": "yellow", "error": "red"}
 NOTICE_SECONDS = 8.0  # a notification closes itself after this long

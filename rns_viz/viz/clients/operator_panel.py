@@ -1,6 +1,6 @@
 """Per-client "Operator" panel: who operates, and Take control / Release control buttons.
 
-Every connected browser sees the same simulation; the :class:`~rns_viz.live.operator_lock.OperatorLock`
+Every connected browser sees the same simulation; the :class:`~rns_viz.live.operator.operator_lock.OperatorLock`
 decides whose inputs count. Each client gets its own small panel (``client.gui``) with its status
 line ("You are operating" / "Watching — client 3 is operating"), a password field when the
 session has one, and the two buttons. The render thread calls :meth:`OperatorPanels.refresh`.
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import viser
 
-from rns_viz.live.operator_lock import LockRefused, OperatorLock
+from rns_viz.live.operator.operator_lock import LockRefused, OperatorLock
 
 Notify = Callable[[viser.ClientHandle | None, str, str, str], None]
 

@@ -3,7 +3,7 @@ the selection S (which reactions must vanish, Sec. III-B) with the reaction null
 n - r, whether the handle's orientation is tracked too (n - r >= 4: rotational DOF left over), and a
 live plot of every base coordinate. Hidden for a 1-DOF base.
 
-The checkboxes make one typed command (:class:`~rns_viz.live.commands.SetSelection`) the loop
+The checkboxes make one typed command (:class:`~rns_viz.live.loop.commands.SetSelection`) the loop
 applies; what the loop refuses (an RNS the app does not operate) comes back as a notice and the
 boxes show the selection in force again.
 """
@@ -14,11 +14,11 @@ import numpy as np
 import viser
 
 from rns_viz.defaults import KICK_LEVER_M
-from rns_viz.live.plots import BASE_COORDINATES
-from rns_viz.live.records import Snapshot
+from rns_viz.live.published.plot_buffers import BASE_COORDINATES
+from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.model import FsmsModel
 from rns_viz.params import key_selection
-from rns_viz.viz.inputs import Controls
+from rns_viz.viz.panels.inputs import Controls
 
 COLOURS = ("#1f6fd1", "#e0503a", "#2a9d4b", "#8e44ad", "#c77700", "#555555")
 ALL = "all together"

@@ -14,13 +14,13 @@ import viser
 import viser.uplot
 
 from rns_viz.defaults import defaults_for
-from rns_viz.live.commands import LIVE_LAWS as LAW_KINDS
-from rns_viz.live.laws import LAW_LABELS
-from rns_viz.live.pacing import SPEEDS
+from rns_viz.live.loop.commands import LIVE_LAWS as LAW_KINDS
+from rns_viz.live.loop.wall_clock import SPEEDS
+from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.params import model_source
 from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, PANDA_SCENARIOS
-from rns_viz.viz.live_plots import LivePlots
-from rns_viz.viz.model_menu import ModelMenu
+from rns_viz.viz.panels.live_plots import LivePlots
+from rns_viz.viz.panels.model_menu import ModelMenu
 
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")

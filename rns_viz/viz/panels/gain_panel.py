@@ -17,13 +17,13 @@ import viser
 import viser.uplot
 
 from rns_viz.analysis import GAIN_RANGE, Locus, Modes
-from rns_viz.live.gain_explorer import GainView
-from rns_viz.live.session import Session
-from rns_viz.viz.connections import Connections
-from rns_viz.viz.gain_scene import LN10, GainScene, Quantity
-from rns_viz.viz.gui import GAIN_SLIDERS, GuiElements
-from rns_viz.viz.inputs import Controls
-from rns_viz.viz.style import SceneStyle
+from rns_viz.live.explorer.gain_explorer import GainView
+from rns_viz.live.loop.session import Session
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels.control_panel import GAIN_SLIDERS, GuiElements
+from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.scene.gain_scene import LN10, GainScene, Quantity
+from rns_viz.viz.scene.style import SceneStyle
 
 QUANTITIES: dict[str, Quantity] = {
     "base mode σ_b (1/s)": "base",

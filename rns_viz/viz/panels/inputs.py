@@ -2,7 +2,7 @@
 
 A callback checks only what belongs to the widget (a slider value of the right type within its
 bounds, a dropdown value among its options, a finite drag position; see
-:mod:`rns_viz.viz.input_check`) and calls the session's command method, which checks the meaning
+:mod:`rns_viz.viz.panels.input_check`) and calls the session's command method, which checks the meaning
 (gains, speeds, targets) and raises ``ValueError`` if it refuses. Refused input is reported to its
 client and the control is shown its last good value again at the next render frame.
 """
@@ -19,12 +19,12 @@ from typing import Any
 import numpy as np
 import viser
 
-from rns_viz.live.laws import LAW_LABELS
-from rns_viz.live.session import Session
-from rns_viz.viz.connections import Connections
-from rns_viz.viz.gui import SPEED_LABELS, GuiElements
-from rns_viz.viz.input_check import check_value
-from rns_viz.viz.live_plots import SCALES
+from rns_viz.live.loop.session import Session
+from rns_viz.live.runs.laws import LAW_LABELS
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements
+from rns_viz.viz.panels.input_check import check_value
+from rns_viz.viz.panels.live_plots import SCALES
 
 REFUSAL_REPEAT_S = 2.0  # s: a watcher dragging the handle is told at most this often
 
@@ -132,7 +132,7 @@ class Controls:
             self._good[id(handle)] = handle.value
             handle.on_update(callback)
 
-    on_input = _on_input  # for panels built elsewhere (viz/gain_panel.py)
+    on_input = _on_input  # for panels built elsewhere (viz/panels/gain_panel.py)
 
     def _wire(self) -> None:
         g, s = self.gui, self.session

@@ -1,7 +1,7 @@
 """The *Lessons* folder: the lesson in progress (title, equation, explanation, task, progress, ✓ when
 done), Previous / Next / Stop, and a chooser over every lesson of both models.
 
-The lessons and their checks live in :mod:`rns_viz.live.lessons`; this panel only starts and stops
+The lessons and their checks live in :mod:`rns_viz.live.teaching.lessons`; this panel only starts and stops
 them through the session and shows ``snapshot().lesson``. Refreshed by the render thread at 5 Hz.
 """
 
@@ -12,11 +12,11 @@ from collections.abc import Callable
 
 import viser
 
-from rns_viz.live.lessons import LESSONS
-from rns_viz.live.records import LessonStatus, Snapshot
-from rns_viz.live.session import Session
-from rns_viz.viz.connections import Connections
-from rns_viz.viz.view_toggles import ViewToggles
+from rns_viz.live.loop.session import Session
+from rns_viz.live.published.snapshot import LessonStatus, Snapshot
+from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.scene.view_toggles import ViewToggles
 
 MODEL_SHORT = {"trep": "TREP", "planar3r": "3R", "boom7": "boom7"}
 CHOICES: dict[str, tuple[str, int]] = {

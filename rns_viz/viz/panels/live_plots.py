@@ -19,7 +19,7 @@ import numpy as np
 import viser
 import viser.uplot
 
-from rns_viz.viz.units import si
+from rns_viz.viz.panels.units import si
 
 ON_COLOUR, OFF_COLOUR, ERROR_COLOUR = "#1f6fd1", "#e0503a", "#2a9d4b"
 SCALES = {"linear": "linear, fits the data", "symlog": "symmetric log, fixed range"}

@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 
-from rns_viz.live.records import Snapshot
+from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.params import key_selection
-from rns_viz.viz.model_menu import label_of
-from rns_viz.viz.units import si
+from rns_viz.viz.panels.model_menu import label_of
+from rns_viz.viz.panels.units import si
 
 OK_COLOUR = "#1b7f3b"
 WARN_COLOUR = "#c77700"

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import viser
 
-from rns_viz.live.records import Snapshot
+from rns_viz.live.published.snapshot import Snapshot
 
 
 class PathWords:

@@ -14,7 +14,7 @@ import numpy as np
 import viser
 from PIL import Image
 
-from rns_viz.viz.connections import Connections
+from rns_viz.viz.clients.connections import Connections
 
 SIZE = (900, 1600)  # px, height x width of a slide picture
 RENDER_TIMEOUT_S = 20.0

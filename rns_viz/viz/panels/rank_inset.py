@@ -5,7 +5,7 @@ colour) with markers, which a uPlot line chart cannot draw. The field, the axes 
 markers are drawn once per plane with matplotlib (Agg) into an RGB array, in a thread of its own
 (0.1-0.3 s: never in the render thread); each refresh (with the text, 5 Hz) only stamps the arm's
 configuration as a dot into a copy of it, with numpy, and sends the image when the dot moved (a
-~300 px JPEG). Data: :func:`rns_viz.live.rank_view.rank_inset`, whose
+~300 px JPEG). Data: :func:`rns_viz.live.teaching.rank_view.rank_inset`, whose
 configurations are the overlay's (each checked: sigma_min <= 1e-9 of the most coupled ||S H_bm||).
 """
 
@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 import viser
 
-from rns_viz.live.rank_view import RANK_HINT, RankInset, has_rank_inset, inset_slice, rank_inset
-from rns_viz.live.records import Snapshot
+from rns_viz.live.published.snapshot import Snapshot
+from rns_viz.live.teaching.rank_view import RANK_HINT, RankInset, has_rank_inset, inset_slice, rank_inset
 from rns_viz.model import FsmsModel
-from rns_viz.viz.view_toggles import ViewToggles
+from rns_viz.viz.scene.view_toggles import ViewToggles
 
 SIZE_PX = 300  # width and height of the picture
 DPI = 100

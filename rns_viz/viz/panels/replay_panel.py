@@ -1,10 +1,10 @@
 """The *Record and replay* folder: replay the last N seconds in the app, export them for viser's player
 and as CSV.
 
-The session always keeps the last minute (:mod:`rns_viz.live.recorder`). *Replay* shows the newest N
+The session always keeps the last minute (:mod:`rns_viz.live.outputs.recorder`). *Replay* shows the newest N
 seconds in the scene and the plots while the simulation waits: a timeline to scrub, play / pause, a
 speed from 0.1× to 4×, and *Back to live*, after which the simulation goes on where it was. Every
-input is a session command (:mod:`rns_viz.live.replay` applies them in the loop). The exports run in
+input is a session command (:mod:`rns_viz.live.loop.replay_mode` applies them in the loop). The exports run in
 a thread of their own and download to the clicking browser: a zip of viser's client and the scene
 drawn from the recording (plays from any static file server, no Python), or the steps as CSV.
 """
@@ -18,15 +18,16 @@ import traceback
 
 import viser
 
-from rns_viz.live.commands import REPLAY_SPEEDS
-from rns_viz.live.recorder import MAX_RECORD_S, Recording
-from rns_viz.live.records import Snapshot
-from rns_viz.live.replay import replay_snapshot
-from rns_viz.live.session import Session
-from rns_viz.viz.connections import Connections
-from rns_viz.viz.inputs import Controls
-from rns_viz.viz.recording import PLAYER_URL, player_zip, scene_file
-from rns_viz.viz.view_toggles import ViewToggles
+from rns_viz.live.loop.commands import REPLAY_SPEEDS
+from rns_viz.live.loop.replay_mode import replay_snapshot
+from rns_viz.live.loop.session import Session
+from rns_viz.live.outputs.recorder import MAX_RECORD_S
+from rns_viz.live.published.recording import Recording
+from rns_viz.live.published.snapshot import Snapshot
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.scene.player_export import PLAYER_URL, player_zip, scene_file
+from rns_viz.viz.scene.view_toggles import ViewToggles
 
 DEFAULT_SECONDS = 20.0
 

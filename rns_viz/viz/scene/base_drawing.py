@@ -10,14 +10,14 @@ import numpy as np
 import viser
 
 from rns_viz.model import FsmsModel
-from rns_viz.viz.geometry import (
+from rns_viz.viz.scene.shapes import (
     beam_centrelines,
     plate_strip_faces,
     plate_strip_vertices,
     polyline_segments,
     zigzag,
 )
-from rns_viz.viz.style import CartSpringStyle, DoubleBeamStyle
+from rns_viz.viz.scene.style import CartSpringStyle, DoubleBeamStyle
 
 STEEL = (150, 156, 166)
 DARK = (70, 72, 78)

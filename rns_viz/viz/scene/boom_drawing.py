@@ -16,8 +16,8 @@ import pinocchio as pin
 import viser
 
 from rns_viz.model import FsmsModel
-from rns_viz.viz.geometry import polyline_segments
-from rns_viz.viz.style import BoomStyle
+from rns_viz.viz.scene.shapes import polyline_segments
+from rns_viz.viz.scene.style import BoomStyle
 
 BOOM = (150, 156, 166)
 STRIPE = (40, 40, 46)

@@ -17,12 +17,12 @@ import viser
 
 from rns_viz.model import FsmsModel
 from rns_viz.paths import ReactionlessPath
-from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
-from rns_viz.viz.boom_drawing import BoomDrawing
-from rns_viz.viz.geometry import Trail, path_colours, path_family_segments, polyline_segments
-from rns_viz.viz.reaction_arrows import WrenchArrows
-from rns_viz.viz.robot import RobotMeshes
-from rns_viz.viz.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
+from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.scene.boom_drawing import BoomDrawing
+from rns_viz.viz.scene.reaction_arrows import WrenchArrows
+from rns_viz.viz.scene.robot import RobotMeshes
+from rns_viz.viz.scene.shapes import Trail, path_colours, path_family_segments, polyline_segments
+from rns_viz.viz.scene.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
 
 PATH_COLOUR = (0.62, 0.74, 0.88)  # other reactionless paths, RGB in [0, 1]
 PATH_HIGHLIGHT = (0.90, 0.05, 0.30)  # the current path

@@ -18,8 +18,8 @@ import viser
 import viser.transforms as vtf
 
 from rns_viz.analysis import GainMap
-from rns_viz.live.gain_explorer import GainView
-from rns_viz.viz.style import SceneStyle
+from rns_viz.live.explorer.gain_explorer import GainView
+from rns_viz.viz.scene.style import SceneStyle
 
 Quantity = Literal["base", "time", "arm"]
 LN10 = math.log(10.0)

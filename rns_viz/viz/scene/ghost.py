@@ -1,6 +1,6 @@
 """The shadow run drawn in 3-D: a translucent ghost of the arm and its base, posed from the shadow's q.
 
-The shadow run (rns_viz.live.runs) gets the operated run's inputs and kicks with vibration suppression
+The shadow run (rns_viz.live.runs.run_pair) gets the operated run's inputs and kicks with vibration suppression
 the other way; the ghost shows its state over the operated arm, so suppression on and off are compared
 in the scene. Everything hangs under ``/ghost`` (world frame), which hides it as a whole.
 """
@@ -12,10 +12,10 @@ import trimesh
 import viser
 
 from rns_viz.model import FsmsModel
-from rns_viz.viz.base_drawing import CartSpringDrawing, DoubleBeamDrawing
-from rns_viz.viz.boom_drawing import BoomDrawing
-from rns_viz.viz.robot import RobotMeshes
-from rns_viz.viz.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle
+from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
+from rns_viz.viz.scene.boom_drawing import BoomDrawing
+from rns_viz.viz.scene.robot import RobotMeshes
+from rns_viz.viz.scene.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle
 
 GHOST_COLOUR = (90, 140, 235)  # pale blue, RGB 0-255
 GHOST_OPACITY = 0.35

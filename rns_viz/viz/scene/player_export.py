@@ -1,6 +1,6 @@
 """A recording as a folder that plays in viser's own client with no Python running.
 
-:func:`scene_file` draws an immutable recording of the live session (:mod:`rns_viz.live.recorder`)
+:func:`scene_file` draws an immutable recording of the live session (:mod:`rns_viz.live.published.recording`)
 frame by frame into a private, unconnected viser server's scene (the same arm, base, ghost and
 teaching arrows as the app) while viser's scene serializer records every message with the recorded
 time between frames; :func:`player_zip` packs viser's built client (one ``index.html``) and the
@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 import viser
 
-from rns_viz.live.recorder import Recording
-from rns_viz.live.records import Overlays, ReplayView, Snapshot
-from rns_viz.live.replay import replay_snapshot
-from rns_viz.viz.scene import FsmsScene
-from rns_viz.viz.teach_scene import TeachScene
-from rns_viz.viz.view_toggles import ViewToggles
+from rns_viz.live.loop.replay_mode import replay_snapshot
+from rns_viz.live.published.recording import Recording
+from rns_viz.live.published.snapshot import Overlays, ReplayView, Snapshot
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.teach_scene import TeachScene
+from rns_viz.viz.scene.view_toggles import ViewToggles
 
 RECORDING_NAME = "rns_scene.viser"
 PLAYER_URL = f"index.html?playbackPath={RECORDING_NAME}"  # open this from a static server of the folder

@@ -1,6 +1,6 @@
 """The rank-deficiency overlay: the poses where S H_bm loses rank, drawn in the base frame.
 
-Data from the live layer (:func:`rns_viz.live.rank_view.rank_overlay`); computed the first time the
+Data from the live layer (:func:`rns_viz.live.teaching.rank_view.rank_overlay`); computed the first time the
 *Show in the scene* box is ticked (under a second for the 3R), then kept. Each pose is drawn as the
 arm's links (line segments) with a dot at its end effector, and a short label; the full sentence of
 why is the checkbox's hint (``RANK_HINT``).
@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from rns_viz.live.rank_view import RANK_LABEL, RankOverlay, rank_overlay
+from rns_viz.live.teaching.rank_view import RANK_LABEL, RankOverlay, rank_overlay
 from rns_viz.model import FsmsModel
-from rns_viz.viz.style import SceneStyle
+from rns_viz.viz.scene.style import SceneStyle
 
 RANK_COLOUR = (200, 120, 0)  # amber: configurations to know about, not to use
 

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 import viser
 
-from rns_viz.viz.style import SceneStyle
+from rns_viz.viz.scene.style import SceneStyle
 
 MOMENT_COLOUR = (200, 0, 140)  # magenta: apart from the force's red and the coupling momentum's purple
 

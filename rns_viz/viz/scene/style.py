@@ -11,7 +11,7 @@ from typing import Literal
 
 import numpy as np
 
-from rns_viz.live.readouts import arm_reach
+from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_source
 

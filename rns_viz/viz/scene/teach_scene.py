@@ -2,7 +2,7 @@
 vector n as the hand velocity it produces, and arrows for the direction of increasing ū on the path.
 
 Built with the scene (and again after a model switch) and drawn by the render thread each frame;
-each part follows its checkbox in *Show in the scene* (:mod:`rns_viz.viz.view_toggles`).
+each part follows its checkbox in *Show in the scene* (:mod:`rns_viz.viz.scene.view_toggles`).
 """
 
 from __future__ import annotations
@@ -10,13 +10,14 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from rns_viz.live.readouts import arm_reach, coupling_sigma, null_motion
-from rns_viz.live.records import Snapshot
+from rns_viz.live.outputs.readouts import coupling_sigma, null_motion
+from rns_viz.live.published.snapshot import Snapshot
+from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
-from rns_viz.viz.ghost import Ghost
-from rns_viz.viz.region_outline import outline_points
-from rns_viz.viz.scene import PATH_HIGHLIGHT, FsmsScene
-from rns_viz.viz.view_toggles import ViewToggles
+from rns_viz.viz.scene.fsms_scene import PATH_HIGHLIGHT, FsmsScene
+from rns_viz.viz.scene.ghost import Ghost
+from rns_viz.viz.scene.region_outline import outline_points
+from rns_viz.viz.scene.view_toggles import ViewToggles
 
 L_COLOUR = (120, 40, 170)  # purple: coupling momentum
 N_COLOUR = (235, 130, 0)  # orange: null-space direction at the hand

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import viser
 
-from rns_viz.live.rank_view import RANK_HINT
-from rns_viz.viz.connections import Connections
+from rns_viz.live.teaching.rank_view import RANK_HINT
+from rns_viz.viz.clients.connections import Connections
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
 TOGGLES: tuple[tuple[str, str, bool, str], ...] = (

@@ -1,10 +1,10 @@
-"""The live app: a viser server showing a :class:`~rns_viz.live.session.Session`.
+"""The live app: a viser server showing a :class:`~rns_viz.live.loop.session.Session`.
 
-Four parts, one concern each: :class:`~rns_viz.viz.inputs.Controls` turns GUI input into the
-session's command methods; :class:`~rns_viz.viz.connections.Connections` holds the clients, the
-operator lock and the password; :class:`~rns_viz.viz.render.Renderer` runs the render thread that
+Four parts, one concern each: :class:`~rns_viz.viz.panels.inputs.Controls` turns GUI input into the
+session's command methods; :class:`~rns_viz.viz.clients.connections.Connections` holds the clients, the
+operator lock and the password; :class:`~rns_viz.viz.server.render.Renderer` runs the render thread that
 sends the session's snapshots, plots, text, overlays and notices to the browsers;
-:class:`~rns_viz.viz.client_pace.ClientPace` paces what each browser receives to what it can draw.
+:class:`~rns_viz.viz.server.page_pacing.ClientPace` paces what each browser receives to what it can draw.
 
     serve()                      # TREP on http://127.0.0.1:8080, blocking
     app = start_app(port=0)      # non-blocking; app.port, app.session, app.gui; app.stop()
@@ -20,23 +20,23 @@ from typing import Any
 
 import viser
 
-from rns_viz.live.operator_lock import OperatorLock
-from rns_viz.live.session import Session
+from rns_viz.live.loop.session import Session
+from rns_viz.live.operator.operator_lock import OperatorLock
 from rns_viz.model import FsmsModel
-from rns_viz.viz.base_panel import BasePanel
-from rns_viz.viz.client_pace import ClientPace
-from rns_viz.viz.connections import Connections
-from rns_viz.viz.gui import GuiElements, make_gui
-from rns_viz.viz.inputs import Controls
-from rns_viz.viz.lesson_panel import LessonPanel
-from rns_viz.viz.model_menu import ModelMenu
-from rns_viz.viz.path_words import PathWords
-from rns_viz.viz.pictures import Pictures
-from rns_viz.viz.rank_inset import RankInsetPanel
-from rns_viz.viz.render import TARGET_HANDLE, Renderer
-from rns_viz.viz.replay_panel import ReplayPanel
-from rns_viz.viz.scene import FsmsScene
-from rns_viz.viz.view_toggles import make_view_toggles
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels.base_panel import BasePanel
+from rns_viz.viz.panels.control_panel import GuiElements, make_gui
+from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.panels.lesson_panel import LessonPanel
+from rns_viz.viz.panels.model_menu import ModelMenu
+from rns_viz.viz.panels.path_words import PathWords
+from rns_viz.viz.panels.pictures import Pictures
+from rns_viz.viz.panels.rank_inset import RankInsetPanel
+from rns_viz.viz.panels.replay_panel import ReplayPanel
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.view_toggles import make_view_toggles
+from rns_viz.viz.server.page_pacing import ClientPace
+from rns_viz.viz.server.render import TARGET_HANDLE, Renderer
 
 IDLE_RESTART_S = 60.0  # s of simulated time: a session older than this restarts for its first visitor
 
@@ -161,7 +161,7 @@ def start_app(
     ``lesson``: start at that lesson (1-based) of the model; ``model`` is a bundled name or a parameter
     file (ModelFileError names the element at fault), ``models`` more files for the model dropdown;
     ``pace=False``: every page gets every update however slowly it draws (for comparisons; see
-    :mod:`rns_viz.viz.client_pace`)."""
+    :mod:`rns_viz.viz.server.page_pacing`)."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")

@@ -16,7 +16,7 @@ burst of 3-D frames for every message that is not GUI-only, a question included,
 messages at once without a frame, so a page with no new scene to show is left alone: a paused app's page
 draws no frames (software WebGL at 4 questions a second drew ~17 a second), nor does a running app's page
 while the arms rest and only the panel's numbers change (it drew ~9 a second, for the questions alone).
-:class:`~rns_viz.viz.pace_control.PaceController` turns answer times into a rate per client.
+:class:`~rns_viz.viz.server.page_rate.PaceController` turns answer times into a rate per client.
 
 The means: the scene, the plots and the text are broadcast (``server.scene`` / ``server.gui``),
 one stream that viser sends to each client from a persistent buffer in which a newer message for
@@ -49,7 +49,7 @@ from typing import Any
 import viser
 import viser._messages as viser_messages
 
-from rns_viz.viz.pace_control import FULL_HZ, PaceController
+from rns_viz.viz.server.page_rate import FULL_HZ, PaceController
 
 PING_KEY = "rns_viz_pace"  # the localStorage key asked for (its value does not matter)
 PING_GAP_S = 0.25  # s between an answer and the next question

@@ -1,7 +1,7 @@
 """How often one browser gets the scene and the plots: a rate that follows the page's answer time.
 
 Pure logic (no viser, no clock of its own: every call is given ``now`` in seconds), driven by
-:mod:`rns_viz.viz.client_pace`. The server asks each page a small question (a ping) and times the
+:mod:`rns_viz.viz.server.page_pacing`. The server asks each page a small question (a ping) and times the
 answer. A page answers after it has applied everything sent before the question, so the answer
 time is how old the state it shows is. Part of it is the page's own time to draw one frame (a
 software-rendered page needs a frame to answer at all): the quickest of its recent answers. The

@@ -16,24 +16,24 @@ import numpy as np
 import viser
 
 from rns_viz.defaults import defaults_for
-from rns_viz.live.dual import is_dual
-from rns_viz.live.laws import LAW_LABELS
-from rns_viz.live.readouts import arm_reach
-from rns_viz.live.records import Snapshot
-from rns_viz.live.replay import replay_snapshot
-from rns_viz.live.session import Session
+from rns_viz.live.loop.replay_mode import replay_snapshot
+from rns_viz.live.loop.session import Session
+from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.published.snapshot import Snapshot
+from rns_viz.live.reach.region import arm_reach
+from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.model import FsmsModel
-from rns_viz.viz.base_panel import BasePanel
-from rns_viz.viz.connections import Connections
-from rns_viz.viz.gain_panel import GainExplorerView
-from rns_viz.viz.gui import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
-from rns_viz.viz.inputs import Controls
-from rns_viz.viz.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
-from rns_viz.viz.panel_text import readouts_html, status_html
-from rns_viz.viz.rank_scene import RankScene
-from rns_viz.viz.scene import FsmsScene
-from rns_viz.viz.teach_scene import TeachScene
-from rns_viz.viz.view_toggles import ViewToggles
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels.base_panel import BasePanel
+from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
+from rns_viz.viz.panels.gain_panel import GainExplorerView
+from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
+from rns_viz.viz.panels.panel_text import readouts_html, status_html
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.rank_scene import RankScene
+from rns_viz.viz.scene.teach_scene import TeachScene
+from rns_viz.viz.scene.view_toggles import ViewToggles
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
