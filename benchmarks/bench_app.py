@@ -16,7 +16,7 @@ its threads); clients run in this process. Scenarios, each with the shadow run o
    apart every 2.5 s, server side, the compensator cancelling, the shadow's held; boom7: its r = 6
    reactionless path played to the other end every 5 s) and the base is kicked every 5 s from the
    page's button (boom7: sideways, along y, the direction control's default);
-2. four protocol-level websocket clients (tests/protocol_client.py), decoding everything they receive;
+2. four protocol-level websocket clients (tests/support/protocol_client.py), decoding everything they receive;
 3. latency: a websocket client sends target drags and gain-slider changes at 20 Hz; the app
    reports, for each, the time from its GUI callback to the start of the first step that used it.
 
@@ -203,7 +203,7 @@ def kicker(ws: Any, uuid: str, stop: threading.Event, every: float = 5.0) -> Non
 
 
 def scenario_browser(model: str, seconds: float, teach: str | None = None) -> dict[str, Any] | None:
-    from tests.browser import CHROMIUM, CHROMIUM_FLAGS, wait_until
+    from tests.support.browser import CHROMIUM, CHROMIUM_FLAGS, wait_until
 
     if not CHROMIUM.is_file():
         print(f"\n== one browser: skipped (no {CHROMIUM})")
@@ -251,7 +251,7 @@ def scenario_teach(model: str, seconds: float) -> None:
 
 
 def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
-    from tests.protocol_client import ProtocolClient
+    from tests.support.protocol_client import ProtocolClient
 
     srv = Server(model)
     clients: list[ProtocolClient] = []
@@ -279,7 +279,7 @@ def scenario_clients(model: str, seconds: float, count: int = 4) -> None:
 
 
 def scenario_latency(model: str, seconds: float) -> None:
-    from tests.protocol_client import ProtocolClient
+    from tests.support.protocol_client import ProtocolClient
 
     srv = Server(model)
     ws = None

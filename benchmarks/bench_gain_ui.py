@@ -29,8 +29,8 @@ LAWS = {"trep": ("velocity", "acceleration"), "planar3r": ("acceleration", "torq
 def main() -> None:
     from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction
     from rns_viz.viz.server.app import start_app
-    from tests.browser import wait_for_clients, wait_until
-    from tests.protocol_client import ProtocolClient
+    from tests.support.browser import wait_for_clients, wait_until
+    from tests.support.protocol_client import ProtocolClient
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", choices=("trep", "planar3r"), default="trep")

@@ -15,7 +15,7 @@ runs in a child process (its real-time factor is not disturbed by the clients); 
    server applied the kick), the page's requestAnimationFrame rate, the browser's memory (RSS of
    all chromium processes and the page's JS heap), and the page's answer time as the server
    measures it.
-2. One software-rendered page plus 3 protocol-level clients (tests/protocol_client.py) with the
+2. One software-rendered page plus 3 protocol-level clients (tests/support/protocol_client.py) with the
    arm in cyclic motion: server real-time factor, scene updates a second received by the fast
    clients, and by the page.
 3. A hidden tab: the page is marked hidden and its main thread stopped (CDP Debugger.pause, as
@@ -221,7 +221,7 @@ def app_and_page(pace: bool) -> Iterator[tuple[App, Any]]:
     """The app (paced or not) and one software-rendered page showing it, its status line watched."""
     from playwright.sync_api import sync_playwright
 
-    from tests.browser import CHROMIUM, CHROMIUM_FLAGS
+    from tests.support.browser import CHROMIUM, CHROMIUM_FLAGS
 
     app = App(pace)
     try:
@@ -261,7 +261,7 @@ def scenario_one_page(pace: bool, minutes: float) -> dict[str, Any]:
 
 
 def scenario_crowd(pace: bool, seconds: float) -> dict[str, Any]:
-    from tests.protocol_client import ProtocolClient
+    from tests.support.protocol_client import ProtocolClient
 
     with app_and_page(pace) as (app, page):
         clients = [ProtocolClient(app.port, decode=True, watch_node="/base/link1") for _ in range(3)]

@@ -68,7 +68,7 @@ def browser_side(name: str, seconds: float = 4.0) -> dict[str, float]:
     from playwright.sync_api import sync_playwright
 
     from rns_viz.viz.server.app import start_app
-    from tests.browser import CHROMIUM, CHROMIUM_FLAGS
+    from tests.support.browser import CHROMIUM, CHROMIUM_FLAGS
 
     app = start_app(name, port=0, verbose=False)
     try:

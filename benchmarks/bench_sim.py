@@ -8,7 +8,7 @@ extension built the law and RK4 run in C++ (rns_viz.sim.native). Baselines:
 
 - "Python step": the same Simulator with ``native=False`` (law and RK4 in Python + pinocchio).
 - "MuJoCo plant": the same AccelerationLaw object driving MuJoCo's ``mj_step`` (RK4, the same URDF
-  loaded by ``tests.oracles.mujoco_replay.build_model``); no log.
+  loaded by ``tests.support.oracles.mujoco_replay.build_model``); no log.
 - "straightforward": the same step written plainly (P_RNS formed, the paper's equations as printed,
   RK4 on separate q and v, a log row with forward kinematics each step; ``benchmarks/oracles.py``,
   with the generated 7-DOF arm). It is also a check: its trajectory must equal the simulator's.
@@ -44,7 +44,7 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # for tests.oracles
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # for tests.support.oracles
 
 from benchmarks.oracles import DT, Straightforward, arm7_model, initial_state
 from rns_viz.control import AccelerationLaw, Gains
@@ -52,7 +52,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.scenarios import trep2_circle
 from rns_viz.sim import Simulator
 from rns_viz.sim import native as native_step
-from tests.oracles.mujoco_replay import build_model
+from tests.support.oracles.mujoco_replay import build_model
 
 GAINS = {
     "trep": Gains(g_b=24.0, g_m=20.0),

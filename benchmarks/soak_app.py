@@ -5,7 +5,7 @@ Run on demand:  python benchmarks/soak_app.py [--seconds 600] [--model trep]
 Prints, every --every seconds, the server's resident memory (RSS) and the real-time factor of
 the simulation over that window; at the end the memory growth after warm-up (target <= 10 MB) and
 the lowest windowed real-time factor (target >= 0.99). The client is a protocol-level websocket
-client on 127.0.0.1 (tests/protocol_client.py), so the server does all its real work: callbacks,
+client on 127.0.0.1 (tests/support/protocol_client.py), so the server does all its real work: callbacks,
 scene and plot messages, the shadow run.
 """
 
@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from rns_viz.model import FsmsModel
 from rns_viz.viz.server.app import TARGET_HANDLE, start_app
-from tests.protocol_client import ProtocolClient, gui_uuid
+from tests.support.protocol_client import ProtocolClient, gui_uuid
 
 
 def rss_mb() -> float:

@@ -1,52 +1,85 @@
-"""Shared fixtures: the bundled models, built once per session; stepped apps, boom7's stepped session and a
-protocol client."""
+"""What every level of the tests shares: markers applied by folder, and the bundled models, each loaded once
+per test session.
+
+Folders are levels: ``unit`` (pure functions and physics: the developer's loop, ``python -m pytest
+tests/unit``), ``session`` (a headless Session), ``app`` (a viser server, protocol clients), ``browser``
+(Chromium). Each test gets its folder's marker, so ``-m unit`` works from anywhere; a browser test also
+gets the browser's skip-or-fail rule and the "live" xdist group (one wall-clock test at a time,
+tests/support/browser.py). The fixtures of one level live in its folder's conftest.py.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 
-from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
-from rns_viz.viz.server.app import RnsApp
-from tests.app_helpers import stepped_app, stepped_session
-from tests.browser import wait_for_clients
-from tests.protocol_client import ProtocolClient
+from rns_viz.params import missing_extra
+
+LEVELS = ("unit", "session", "app", "browser")
+TESTS = Path(__file__).resolve().parent
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups and -m selects by marker
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        level = item.path.relative_to(TESTS).parts[0] if item.path.is_relative_to(TESTS) else None
+        if level not in LEVELS:
+            continue
+        item.add_marker(getattr(pytest.mark, level))
+        if level == "browser":
+            for mark in _browser_marks():
+                item.add_marker(mark)
+
+
+def _browser_marks() -> list[pytest.MarkDecorator]:
+    """The browser marker, its skip-or-fail rule and the "live" group (imported only when browser tests
+    are collected: Playwright and the app are not needed below that level)."""
+    from tests.support.browser import browser_marks
+
+    return browser_marks
 
 
 @pytest.fixture(scope="session")
-def trep() -> FsmsModel:
-    return FsmsModel.from_name("trep")
+def bundled_model() -> Callable[[str], FsmsModel]:
+    """A bundled model by name, loaded once per test session and shared: a test that changes its model
+    loads its own. A model whose optional extra is missing (boom-panda) skips the test."""
+    loaded: dict[str, FsmsModel] = {}
+
+    def load(name: str) -> FsmsModel:
+        extra = missing_extra(name)
+        if extra is not None:
+            pytest.skip(f"{name} needs the optional extra: pip install 'rns-viz[{extra}]'")
+        if name not in loaded:
+            loaded[name] = FsmsModel.from_name(name)
+        return loaded[name]
+
+    return load
 
 
 @pytest.fixture(scope="session")
-def planar3r() -> FsmsModel:
-    return FsmsModel.from_name("planar3r")
+def trep(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
+    return bundled_model("trep")
 
 
-@pytest.fixture
-def trep_app() -> Iterator[RnsApp]:
-    """TREP's app, stepped by the test (tests/app_helpers.py)."""
-    yield from stepped_app("trep")
+@pytest.fixture(scope="session")
+def planar3r(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
+    return bundled_model("planar3r")
 
 
-@pytest.fixture
-def planar_app() -> Iterator[RnsApp]:
-    yield from stepped_app("planar3r")
+@pytest.fixture(scope="session")
+def boom7(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
+    return bundled_model("boom7")
 
 
-@pytest.fixture
-def boom() -> Iterator[Session]:
-    """boom7's session, stepped by the test (no server), its path and reachable set computed."""
-    yield from stepped_session("boom7")
+@pytest.fixture(scope="session")
+def trep2(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
+    return bundled_model("trep2")
 
 
-@pytest.fixture
-def client(request: pytest.FixtureRequest) -> Iterator[ProtocolClient]:
-    """A protocol-level websocket client of the app fixture named by indirect parametrisation."""
-    app: RnsApp = request.getfixturevalue(request.param)
-    ws = ProtocolClient(app.port, decode=True)
-    wait_for_clients(app, 1, "the websocket client to connect")
-    yield ws
-    ws.close()
+@pytest.fixture(scope="session")
+def boom_panda(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
+    """The Franka Panda on boom7's boom; skips without example-robot-data (rns-viz[panda])."""
+    return bundled_model("boom-panda")

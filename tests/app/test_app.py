@@ -1,7 +1,7 @@
 """The live app, headless: a real viser server on 127.0.0.1, driven like a browser would drive it.
 
 Inputs go through the app's own GUI handles and scene handle, either set on the server or sent by
-a protocol-level websocket client (tests/protocol_client.py), so viser's real callback path runs. The
+a protocol-level websocket client (tests/support/protocol_client.py), so viser's real callback path runs. The
 session is made with ``realtime=False`` and advanced faster than real time with ``advance()``;
 one test runs the real-time loop, and one (marked ``perf``, not in the default run) checks its timing.
 """
@@ -18,10 +18,10 @@ import pytest
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, serve, start_app
-from tests.app_helpers import queued, uuid
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient
-from tests.test_scenarios import PAPER_PRESETS
+from tests.support.app_helpers import queued, uuid
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient
+from tests.unit.test_scenarios import PAPER_PRESETS
 
 
 def peak_xb(session: Session, seconds: float) -> float:

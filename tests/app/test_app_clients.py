@@ -18,16 +18,16 @@ import sys
 import threading
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rns_viz.viz.server.app import TARGET_HANDLE, start_app
-from tests.browser import live_group, wait_until
-from tests.protocol_client import ProtocolClient, gui_uuid
+from tests.support.browser import live_group, wait_until
+from tests.support.protocol_client import ProtocolClient, gui_uuid
+from tests.support.repo import REPO
 
-pytestmark = live_group  # servers running in real time: one at a time (tests/browser.py)
+pytestmark = live_group  # servers running in real time: one at a time (tests/support/browser.py)
 
 DURATION_S = 30.0  # wall seconds of churn when the real-time factor is asserted (the issue asks for 30 s)
 BEHAVIOUR_S = 10.0  # wall seconds of churn for the behaviour alone: some 60 connects and deaths of clients
@@ -100,9 +100,9 @@ def eight_clients_come_and_go_while_one_drags(capfd: pytest.CaptureFixture[str],
             [
                 sys.executable,
                 "-c",
-                f"from tests.test_app_clients import churn_process; churn_process({app.port}, {seconds})",
+                f"from tests.app.test_app_clients import churn_process; churn_process({app.port}, {seconds})",
             ],
-            cwd=Path(__file__).resolve().parents[1],
+            cwd=REPO,
             stderr=subprocess.PIPE,
             text=True,
         )

@@ -21,8 +21,8 @@ from hypothesis import strategies as st
 
 from rns_viz.viz.panels.control_panel import GuiElements
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient, gui_uuid
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient, gui_uuid
 
 EXAMPLES = 40  # per model: ~15 s each
 INPUT_TYPES = (

@@ -18,8 +18,8 @@ from rns_viz.params import ASSETS_DIR
 from rns_viz.viz.panels.base_panel import BasePanel
 from rns_viz.viz.panels.model_menu import MODEL_LABELS
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient, gui_uuid
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient, gui_uuid
 
 
 def user_model(folder: Path) -> Path:

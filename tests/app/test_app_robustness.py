@@ -9,9 +9,9 @@ import pytest
 import rns_viz.viz.server.render as render
 from rns_viz.control import InvalidGain
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
-from tests.app_helpers import queued, uuid
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient
+from tests.support.app_helpers import queued, uuid
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)

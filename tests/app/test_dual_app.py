@@ -12,8 +12,8 @@ import pytest
 
 from rns_viz.viz.panels.panel_text import BAD_COLOUR, OK_COLOUR, readouts_html
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import wait_until
-from tests.test_teach import independent_reaction, log_row
+from tests.support.browser import wait_until
+from tests.support.logs import independent_reaction, log_row
 
 
 @pytest.fixture

@@ -13,8 +13,8 @@ import pytest
 from rns_viz.viz.panels.gain_panel import QUANTITIES, GainExplorerView, locus_data
 from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction, colours, grid_point, map_image
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient
 
 
 def explorer(app: RnsApp) -> GainExplorerView:

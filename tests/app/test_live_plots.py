@@ -1,46 +1,17 @@
-"""The live plots without a browser: units, the on/off colouring, the peaks, chart options that never
-change (a changed option rebuilds the chart in the browser, which pinned fig3's time axis outside
-its data), the plot history restarting on a suppression switch, and presets that start paused."""
+"""The live plots in the app without a browser: chart options that never change (a changed option
+rebuilds the chart in the browser, which pinned fig3's time axis outside its data), a session nobody
+watched restarting for its first visitor, and the legend and caption of each model and of its replay
+(units, colouring, peaks: tests/unit/; the plot history in a session: tests/session/)."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
-import numpy as np
 import pytest
 
-from rns_viz.live.loop.session import Session
-from rns_viz.live.published.plot_buffers import PLOT_SERIES
-from rns_viz.viz.panels.live_plots import on_off, peaks_html
-from rns_viz.viz.panels.units import si
 from rns_viz.viz.server.app import IDLE_RESTART_S, start_app
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient
-
-
-def test_si_prefixes_and_zeros() -> None:
-    assert si(2.1e-6, "m") == "2.1 µm"
-    assert si(0.00132, "m") == "1.32 mm"
-    assert si(0.45, "N·s") == "450 mN·s"
-    assert si(-1.2e-42, "N", floor=1e-6) == "0 N"  # not "-1.2e-42 N"
-    assert si(0.9997e-3, "m") == "1 mm"  # not "1e+03 µm"
-    assert si(3.0, "N", sign=True) == "+3 N" and si(math.nan, "m") == "—"
-
-
-def test_curves_are_coloured_by_suppression_sample_by_sample() -> None:
-    a = {k: np.zeros(4) for k in PLOT_SERIES}
-    a["xb"], a["xb_shadow"] = np.array([1.0, 2.0, 3.0, 4.0]), np.array([-1.0, -2.0, -3.0, -4.0])
-    a["suppress"] = np.array([1.0, 1.0, 0.0, 0.0])  # suppression switched off after two samples
-    on, off = on_off(a, "xb")
-    assert on.tolist() == [1.0, 2.0, -3.0, -4.0] and off.tolist() == [-1.0, -2.0, 3.0, 4.0]
-
-
-def test_peaks_table_carries_si_values() -> None:
-    text = peaks_html({"xb": (2.8e-6, 1.3e-3), "L": (0.02, math.nan), "e": (4e-3, math.nan)})
-    assert 'data-peak="xb-on" data-si="2.8e-06"' in text and "2.8 µm" in text and "1.3 mm" in text
-    assert 'data-peak="L-off" data-si="nan"' in text and "—" in text
-    assert "suppression on" in text and "suppression off" in text
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient
 
 
 def _options(handle: object) -> tuple[str, ...]:
@@ -75,45 +46,6 @@ def test_chart_options_never_change_with_presets_models_and_suppression() -> Non
         sent("the fig3 preset", fig3)
     finally:
         app.stop()
-
-
-def test_suppression_switch_restarts_both_runs_and_the_plot_history() -> None:
-    s = Session("trep", realtime=False)
-    try:
-        s.kick(0.8)
-        s.advance(1.0)
-        assert len(s.plot_arrays()["t"]) == 50 and np.all(s.plot_arrays()["suppress"] == 1.0)
-        before = s.snapshot()
-        assert before.q_shadow is not None and abs(before.q_shadow[0] - before.q[0]) > 5e-4  # m: rings apart
-        s.set_suppression(False)
-        s.advance(0.001)
-        snap = s.snapshot()
-        assert snap.q_shadow is not None  # the shadow restarted from the operated state (one step apart)
-        assert abs(snap.q_shadow[0] - snap.q[0]) < 2e-5 and np.allclose(snap.q_shadow, snap.q, atol=1e-3)
-        s.advance(0.099)
-        a = s.plot_arrays()
-        assert len(a["t"]) == 5 and np.all(a["suppress"] == 0.0)  # only samples since the switch
-        s.set_suppression(False)  # no change: nothing restarts
-        s.advance(0.1)
-        assert len(s.plot_arrays()["t"]) == 10
-    finally:
-        s.stop()
-
-
-def test_a_preset_can_start_paused() -> None:
-    s = Session("trep", realtime=False)
-    try:
-        s.load_preset("fig11-fast", paused=True)
-        s.advance(0.0)
-        assert s.wait_background()
-        s.advance(1.0)
-        snap = s.snapshot()
-        assert snap.settings.preset == "fig11-fast" and snap.paused and snap.t == 0.0
-        s.resume()
-        s.advance(0.5)
-        assert s.snapshot().t == pytest.approx(0.5)
-    finally:
-        s.stop()
 
 
 def test_a_session_nobody_watched_restarts_for_its_first_visitor(monkeypatch: pytest.MonkeyPatch) -> None:

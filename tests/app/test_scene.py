@@ -1,4 +1,5 @@
-"""Headless tests of the viser scene layer: nodes, poses and geometry, no browser."""
+"""The viser scene on a server, no browser: its nodes, the arm posed and the base drawn, the path family,
+reachable set, target, force and trail (its pure geometry: tests/unit/test_scene.py)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from rns_viz.paths import path_family
 from rns_viz.viz import FsmsScene
 from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.scene.fsms_scene import PATH_HIGHLIGHT
-from rns_viz.viz.scene.shapes import Trail, guided_cantilever, path_family_segments, simplify, zigzag
+from tests.support.drawing import distance_to_segments
 
 
 @pytest.fixture(scope="module")
@@ -89,15 +90,6 @@ def test_cart_and_spring_follow_the_base(planar_scene: FsmsScene, planar3r: Fsms
     assert np.allclose(points[-1, 1], [0.3 + spring.attach[0], 0.0, spring.attach[2]], atol=1e-6)
 
 
-def _distance_to_segments(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """Each point's distance (m) to the nearest of the segments (K, 2, 3): a test oracle."""
-    a, b = segments[:, 0], segments[:, 1]
-    ab = b - a
-    rel = points[:, None, :] - a[None]
-    t = np.clip(np.einsum("pkj,kj->pk", rel, ab) / np.maximum(np.einsum("kj,kj->k", ab, ab), 1e-300), 0.0, 1.0)
-    return np.linalg.norm(rel - t[..., None] * ab[None], axis=2).min(axis=1)
-
-
 def _drawn_path(points: np.ndarray, is_path: np.ndarray) -> np.ndarray:
     """The drawn segments of one path, checked to join end to start."""
     mine = points[is_path]
@@ -117,39 +109,15 @@ def test_path_family_is_one_node_with_the_current_path_highlighted(trep_scene: F
     tolerance = trep_scene.style.path_tolerance
     drawn, ee = _drawn_path(points, is_current), paths[3].ee
     assert np.allclose(drawn[0, 0], ee[0], atol=1e-6) and np.allclose(drawn[-1, 1], ee[-1], atol=1e-6)
-    assert _distance_to_segments(drawn[:, 0], ee[:, None, :].repeat(2, axis=1)).max() < 1e-6  # its own points
-    assert _distance_to_segments(ee, drawn).max() <= tolerance + 1e-6  # and never farther than the tolerance
+    assert distance_to_segments(drawn[:, 0], ee[:, None, :].repeat(2, axis=1)).max() < 1e-6  # its own points
+    assert distance_to_segments(ee, drawn).max() <= tolerance + 1e-6  # and never farther than the tolerance
     trep_scene.set_current_path(5)  # recolour only
     is_current = np.all(np.asarray(trep_scene.paths.colors) == highlight, axis=(1, 2))
     drawn = _drawn_path(points, is_current)
     assert np.allclose(drawn[0, 0], paths[5].ee[0], atol=1e-6) and np.allclose(drawn[-1, 1], paths[5].ee[-1], atol=1e-6)
-    assert _distance_to_segments(paths[5].ee, drawn).max() <= tolerance + 1e-6
+    assert distance_to_segments(paths[5].ee, drawn).max() <= tolerance + 1e-6
     with pytest.raises(IndexError):
         trep_scene.set_path_family(paths, len(paths))
-
-
-def test_long_paths_are_thinned() -> None:
-    curve = np.column_stack([np.linspace(0, 1, 1000), np.zeros(1000), np.zeros(1000)])  # straight
-    segs, colours, owners = path_family_segments([curve, curve[:10]], None, 100, (0.5, 0.5, 0.5), (1, 0, 0))
-    assert len(segs) == 99 + 9 and np.all(owners[:99] == 0)  # tolerance 0: every thinned point is kept
-    assert np.allclose(segs[0, 0], curve[0]) and np.allclose(segs[98, 1], curve[-1])
-    assert np.allclose(colours, 0.5)
-
-
-@pytest.mark.parametrize("tolerance", [1e-4, 1e-3, 1e-2])
-def test_simplified_paths_stay_within_the_tolerance_with_fewer_points(tolerance: float) -> None:
-    s = np.linspace(0.0, 1.0, 2000)
-    curve = np.column_stack([s, 0.2 * np.sin(7 * s), 0.05 * np.cos(3 * s)])
-    kept = simplify(curve, tolerance)
-    rows = [int(np.flatnonzero((curve == point).all(axis=1))[0]) for point in kept]  # whole points of the curve
-    assert rows[0] == 0 and rows[-1] == len(curve) - 1 and np.all(np.diff(rows) > 0)  # in order, ends kept
-    assert len(kept) < len(curve) / 4
-    assert _distance_to_segments(curve, np.stack([kept[:-1], kept[1:]], axis=1)).max() <= tolerance
-    line = np.column_stack([s, 2 * s, -s])
-    assert len(simplify(line, tolerance)) == 2  # a straight line is its two ends
-    there_and_back = np.array([[0.0, 0, 0], [1.0, 0, 0], [0.0, 0, 0]])
-    assert len(simplify(there_and_back, tolerance)) == 3  # a reversal is kept, however short its chord
-    assert len(simplify(line, 0.0)) == len(line)  # no tolerance: nothing dropped, even on a straight line
 
 
 def test_reachable_set_target_and_force(planar_scene: FsmsScene) -> None:
@@ -171,17 +139,6 @@ def test_reachable_set_target_and_force(planar_scene: FsmsScene) -> None:
     assert not planar_scene.force.visible
 
 
-def test_trail_is_bounded_and_restarts_after_a_jump() -> None:
-    trail = Trail(capacity=5, min_step=0.01, max_jump=1.0)
-    for k in range(8):
-        assert trail.push(np.array([0.1 * k, 0.0, 0.0]))
-    assert not trail.push(np.array([0.705, 0.0, 0.0]))  # closer than min_step
-    pts = trail.points()
-    assert len(pts) == 5 and np.allclose(pts[:, 0], [0.3, 0.4, 0.5, 0.6, 0.7])
-    trail.push(np.array([5.0, 0.0, 0.0]))
-    assert len(trail) == 1
-
-
 def test_scene_trail_follows_the_end_effector(trep_scene: FsmsScene, trep: FsmsModel) -> None:
     trep_scene.clear_trail()
     for t in np.linspace(0.0, 1.0, 50):
@@ -189,17 +146,6 @@ def test_scene_trail_follows_the_end_effector(trep_scene: FsmsScene, trep: FsmsM
     segs = np.asarray(trep_scene.trail_node.points)
     assert trep_scene.trail_node.visible and 10 < len(segs) < trep_scene.style.trail_capacity
     assert np.allclose(np.linalg.norm(segs[:, :, :2] - [0.0, 0.5], axis=-1), 0.2, atol=1e-5)  # a circle arc
-
-
-def test_beam_shape_and_spring_geometry() -> None:
-    xi = np.linspace(0, 1, 101)
-    u = guided_cantilever(xi)
-    assert u[0] == 0 and u[-1] == 1 and np.isclose(u[50], 0.5)
-    h = 1e-6
-    slope = (guided_cantilever(np.array([h, 1.0])) - guided_cantilever(np.array([0.0, 1.0 - h]))) / h
-    assert np.all(np.abs(slope) < 1e-5)  # clamped root, guided tip: no slope at either end
-    pts = zigzag(np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), coils=4, amplitude=0.1)
-    assert np.allclose(pts[0], 0) and np.allclose(pts[-1], [1, 0, 0]) and np.isclose(np.abs(pts[:, 1]).max(), 0.1)
 
 
 @pytest.mark.perf

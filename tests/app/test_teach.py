@@ -1,7 +1,7 @@
-"""Issue 11, the app's teaching views: the ghost draws the shadow run, the reaction force is Eq. (1)'s.
-
-The reaction is checked against an independent evaluation of Eq. (1) from the step log (pinocchio's
-CRBA and RNEA, a linear solve, no ABA); the ghost against the shadow simulation's own state.
+"""Issue 11, the app's teaching views: the ghost draws the shadow run (against the shadow simulation's
+own state), the drawn n and force are the model's, the lesson panel, the reachable region's outline,
+the scene recording, and hostile values for the new controls (the reaction readout against Eq. (1) in a
+session: tests/session/test_teach.py).
 """
 
 from __future__ import annotations
@@ -12,65 +12,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import wait_until
-
-
-def independent_reaction(model: FsmsModel, row: dict[str, np.ndarray]) -> float:
-    """−(H_bm θ'' + c_b) of Eq. (1) with θ'' from M a = u − c solved directly (not the plant's ABA)."""
-    m, pm = model.m, model.pin_model
-    data = pm.createData()
-    q, v = row["q"], row["v"]
-    M = pin.crba(pm, data, q)
-    M = np.triu(M) + np.triu(M, 1).T
-    c = pin.rnea(pm, data, q, v, np.zeros(model.nv))  # velocity terms (zero gravity)
-    u = np.concatenate([-model.K_b @ q[:m] - model.D_b @ v[:m] + row["f"], row["tau"] - model.D_m @ v[m:]])
-    a = np.linalg.solve(M, u - c)
-    return float(-(M[:m, m:] @ a[m:] + c[:m])[model.selected[0]])
-
-
-def log_row(s: Session, t: float) -> dict[str, np.ndarray]:
-    sim = s.state.runs.sim
-    m, n = sim.model.m, sim.model.n
-    log = sim.log
-    k = int(np.flatnonzero(log.column("t") == t)[0])
-    arr = log.array()[k]
-    col = log.index
-    get = lambda prefix, count: np.array([arr[col[f"{prefix}_{i + 1}"]] for i in range(count)])  # noqa: E731
-    return {
-        "q": np.concatenate([get("xb", m), get("theta", n)]),
-        "v": np.concatenate([get("xbdot", m), get("thetadot", n)]),
-        "tau": get("tau", n),
-        "f": get("fext", m),
-    }
-
-
-@pytest.mark.parametrize(
-    ("model", "peak", "motion"),
-    [("trep", 0.8, "play_fast"), ("planar3r", 5.0, None)],
-)
-def test_reaction_readout_is_eq1_at_its_step(model: str, peak: float, motion: str | None) -> None:
-    s = Session(model, realtime=False)
-    try:
-        assert s.wait_background()
-        if motion is not None:
-            getattr(s, motion)()
-        s.advance(0.05)
-        s.kick(peak)
-        worst, biggest = 0.0, 0.0
-        for _ in range(12):  # during the kick (f_ext != 0) and after it
-            s.advance(0.021)
-            r = s.snapshot().readouts
-            assert np.isfinite(r.reaction_t)
-            expected = independent_reaction(s.state.runs.sim.model, log_row(s, r.reaction_t))
-            worst = max(worst, abs(r.reaction - expected))
-            biggest = max(biggest, abs(expected))
-        assert biggest > 1e-3  # N: the arm does push on the base here
-        assert worst < 1e-9, f"readout differs from Eq. (1) by {worst:.3g} N (largest force {biggest:.3g} N)"
-    finally:
-        s.stop()
+from tests.support.browser import wait_until
 
 
 def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp) -> None:
@@ -113,8 +57,8 @@ def test_drawn_n_and_force_are_the_models(trep_app: RnsApp) -> None:
 
 
 def test_lesson_panel_starts_steps_and_shows_progress_through_the_protocol() -> None:
-    from tests.browser import wait_for_clients
-    from tests.protocol_client import ProtocolClient, gui_uuid
+    from tests.support.browser import wait_for_clients
+    from tests.support.protocol_client import ProtocolClient, gui_uuid
 
     app = start_app("trep", port=0, realtime=False, verbose=False, lesson=1)
     try:
@@ -151,37 +95,6 @@ def test_lesson_panel_starts_steps_and_shows_progress_through_the_protocol() -> 
             assert s.snapshot().lesson is None
     finally:
         app.stop()
-
-
-def test_cli_lesson_option_reaches_the_app(monkeypatch: pytest.MonkeyPatch) -> None:
-    import rns_viz.viz.server.app as app_module
-    from rns_viz import cli
-
-    calls: list[dict[str, object]] = []
-    monkeypatch.setattr(app_module, "serve", lambda **kw: calls.append(kw))
-    assert cli.main(["--lesson", "2"]) == 0
-    assert cli.main(["serve", "--model", "planar3r", "--lesson", "3", "--port", "0"]) == 0
-    assert [(c["model"], c["lesson"]) for c in calls] == [("trep", 2), ("planar3r", 3)]
-    assert cli.main(["serve", "--model", "planar3r", "--lesson", "4"]) == 2  # the 3R has three lessons
-
-
-def test_path_words_turn_ubar_into_joint_angles_and_rates() -> None:
-    from rns_viz.viz.panels.path_words import path_words
-
-    s = Session("trep", realtime=False)
-    try:
-        assert s.wait_background()
-        s.play_slow()
-        s.advance(1.0)
-        snap = s.snapshot()
-        text = path_words(snap)
-        n = snap.readouts.n
-        assert n is not None and snap.sigma is not None
-        assert f"joint 2 at **{np.degrees(snap.q[-1]):.1f}°**" in text
-        # theta' = n u-bar (Eq. 27): joint 2's rate at the chosen u-bar, deg/s
-        assert f"joint 2 {np.degrees(abs(n[1]) * snap.settings.ubar_speed):.0f}°/s" in text
-    finally:
-        s.stop()
 
 
 def test_reachable_region_outline_is_its_edge() -> None:
@@ -234,8 +147,8 @@ def test_scene_recording_is_a_viser_file_of_the_moving_scene(trep_app: RnsApp) -
 
 
 def test_hostile_values_for_the_new_controls_are_set_back_and_the_server_lives(trep_app: RnsApp) -> None:
-    from tests.browser import wait_for_clients
-    from tests.protocol_client import ProtocolClient, gui_uuid
+    from tests.support.browser import wait_for_clients
+    from tests.support.protocol_client import ProtocolClient, gui_uuid
 
     app = trep_app
     with ProtocolClient(app.port, decode=True) as ws:

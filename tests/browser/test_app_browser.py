@@ -6,13 +6,11 @@ from __future__ import annotations
 
 import time
 
-from playwright.sync_api import Page
-
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp
-from tests.browser import (
-    browser_marks,
+from tests.support.browser import (
     browser_page,
+    click_track,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
     screenshot,
@@ -20,20 +18,6 @@ from tests.browser import (
     wait_for_nodes,
     wait_until,
 )
-
-pytestmark = browser_marks
-
-
-def click_track(page: Page, label: str, fraction: float) -> None:
-    """Click the track of the slider labelled ``label`` at ``fraction`` of its width (one action, not many
-    key presses: a software-rendered page answers each input only after its next frame)."""
-    row = page.get_by_text(label, exact=True).locator("xpath=ancestor::*[.//*[@role='slider']][1]")
-    thumb = row.get_by_role("slider")
-    thumb.scroll_into_view_if_needed()
-    track = thumb.locator("xpath=ancestor::div[contains(@class, 'mantine-Slider-root')][1]")
-    box = track.bounding_box()
-    assert box is not None
-    page.mouse.click(box["x"] + fraction * box["width"], box["y"] + 0.5 * box["height"])
 
 
 def test_operate_the_app_in_chromium(app: RnsApp) -> None:

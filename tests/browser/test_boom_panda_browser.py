@@ -13,9 +13,8 @@ import pytest
 from rns_viz import robots
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp
-from tests.app_helpers import realtime_app
-from tests.browser import (
-    browser_marks,
+from tests.support.app_helpers import realtime_app
+from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     screenshot,
@@ -25,7 +24,6 @@ from tests.browser import (
 )
 
 pytestmark = [
-    *browser_marks,
     pytest.mark.skipif(
         not robots.is_installed("example-robot-data/panda"),
         reason="example-robot-data is not installed (pip install 'rns-viz[panda]')",

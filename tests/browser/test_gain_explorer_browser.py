@@ -11,8 +11,7 @@ from playwright.sync_api import Page
 from rns_viz.viz.panels.gain_panel import QUANTITIES
 from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction
 from rns_viz.viz.server.app import RnsApp
-from tests.browser import (
-    browser_marks,
+from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
@@ -21,8 +20,6 @@ from tests.browser import (
     wait_for_nodes,
     wait_until,
 )
-
-pytestmark = browser_marks
 
 
 def screen_point(page: Page, local: tuple[float, float, float]) -> tuple[float, float] | None:

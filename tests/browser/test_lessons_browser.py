@@ -6,7 +6,7 @@ The default run walks one lesson per model; the walk through every lesson only m
 is marked ``docs`` (deselected by default). Screenshots go to ``artifacts/screenshots/``; the ones in
 ``docs/screenshots/`` are made with
 
-    RNS_VIZ_SCREENSHOTS=docs/screenshots python -m pytest -m docs tests/test_lessons_browser.py
+    RNS_VIZ_SCREENSHOTS=docs/screenshots python -m pytest -m docs tests/browser/test_lessons_browser.py
 """
 
 from __future__ import annotations
@@ -26,9 +26,8 @@ from rns_viz.live.teaching.lessons import LESSONS
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.ghost import Ghost
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import (
+from tests.support.browser import (
     ARTIFACTS,
-    browser_marks,
     browser_page,
     dismiss_notifications,
     settle_for_picture,
@@ -36,7 +35,7 @@ from tests.browser import (
     wait_until,
 )
 
-pytestmark = [*browser_marks, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 SHOTS = Path(os.environ.get("RNS_VIZ_SCREENSHOTS", ARTIFACTS / "screenshots"))
 
 
@@ -130,7 +129,7 @@ def walk(model: str, numbers: list[int]) -> None:
 
 
 # One lesson per model in the default run (every lesson's logic is checked headless in
-# tests/test_lessons.py and tests/test_lessons_boom.py): the ones with a ghost, and boom7's lesson on a
+# tests/session/test_lessons.py and tests/session/test_lessons_boom.py): the ones with a ghost, and boom7's lesson on a
 # selected S (a model variant: boom7#S=111000) with a dragged target.
 @pytest.mark.parametrize(("model", "number"), [("trep", 4), ("planar3r", 3), ("boom7", 3)])
 def test_a_lesson_started_from_the_session_shows_in_the_page(model: str, number: int) -> None:

@@ -15,10 +15,8 @@ from playwright.sync_api import Page
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import RnsApp
-from tests.app_helpers import realtime_app
-from tests.browser import browser_marks, browser_page, wait_for_nodes, wait_until
-
-pytestmark = browser_marks
+from tests.support.app_helpers import realtime_app
+from tests.support.browser import browser_page, wait_for_nodes, wait_until
 
 NOTICE = re.compile(r"Display slowed to \d+ Hz to keep up")
 THROTTLE = 16  # times slower: the page's CPU (Chromium's emulation)
@@ -78,7 +76,7 @@ def test_a_throttled_page_is_slowed_told_so_still_operates_and_recovers(trep_app
         client = paced_client(app)
         s.cyclic(True)  # a new picture every frame
         cdp = page.context.new_cdp_session(page)
-        # 16x: a page that draws no pixels (tests/browser.py) still falls behind here at 4x, so this holds on a
+        # 16x: a page that draws no pixels (tests/support/browser.py) still falls behind here at 4x, so this holds on a
         # machine several times faster; at 40x the slowed page took 2 minutes to click through the test
         cdp.send("Emulation.setCPUThrottlingRate", {"rate": THROTTLE})
         wait_until(lambda: app.pace.state(client)["notice"], SLOW_S, "the server to see the page fall behind")

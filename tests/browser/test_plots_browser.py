@@ -19,16 +19,13 @@ from rns_viz.scenarios import SCENARIOS
 from rns_viz.viz.panels.control_panel import PLANAR3R_PRESETS, TREP_PRESETS
 from rns_viz.viz.panels.live_plots import SCALES
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import (
-    browser_marks,
+from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     screenshot,
     settle_for_picture,
     wait_until,
 )
-
-pytestmark = browser_marks
 
 RUN_S = 4.0  # s simulated per preset: every preset's kick or motion is over by then
 CHART_JS = """(uuid) => {

@@ -13,9 +13,8 @@ import numpy as np
 from rns_viz.viz.panels.rank_inset import SIZE_PX
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import start_app
-from tests.browser import (
+from tests.support.browser import (
     ARTIFACTS,
-    browser_marks,
     browser_page,
     dismiss_notifications,
     settle_for_picture,
@@ -23,7 +22,6 @@ from tests.browser import (
     wait_until,
 )
 
-pytestmark = browser_marks
 SHOTS = Path(os.environ.get("RNS_VIZ_SCREENSHOTS", ARTIFACTS / "screenshots"))
 
 IMAGE_SIZE = """(label) => {

@@ -12,8 +12,7 @@ from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.paths import path_family, reactionless_reachable_set, trace_paths
 from rns_viz.viz import FsmsScene
-from tests.browser import (
-    browser_marks,
+from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     local_position,
@@ -23,8 +22,6 @@ from tests.browser import (
     wait_for_nodes,
     wait_until,
 )
-
-pytestmark = browser_marks
 
 DEFLECTION = {"trep": 0.004, "planar3r": 0.1}  # m, x_b shown (times EXAGGERATION) in the screenshot
 EXAGGERATION = {"trep": 10.0, "planar3r": 2.0}  # drawn deflection factor set for the screenshot

@@ -13,9 +13,9 @@ import pytest
 
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
-from tests.browser import (
-    browser_marks,
+from tests.support.browser import (
     browser_page,
+    click_track,
     dismiss_notifications,
     screenshot,
     settle_for_picture,
@@ -23,9 +23,6 @@ from tests.browser import (
     wait_for_nodes,
     wait_until,
 )
-from tests.test_app_browser import click_track
-
-pytestmark = browser_marks
 
 
 @pytest.fixture
@@ -81,7 +78,7 @@ def test_boom7_in_chromium_kick_and_scrub_the_reactionless_path(boom_app: RnsApp
 def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: RnsApp) -> None:
     """r = 3 (forces only): the reactionless-reachable set is drawn, a real mouse drag on the target
     handle's x arrow moves the 3-D target, and the arm follows it without force reactions."""
-    from tests.test_dual_browser import drag_handle_along_x
+    from tests.support.browser import drag_handle_along_x
 
     app, s = boom_app, boom_app.session
     with browser_page(app.server, width=1400, height=900) as page:
@@ -139,7 +136,7 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         # kg m/s. What is left is the arm lagging its reactionless reference each time the target starts and
         # stops: a mouse drag is ten small moves, so it depends on how the page spaces them (0.05-0.12 measured
         # with pages of different speeds; the bound is 0.25). One programmed move keeps under 1 % of the
-        # arm's momentum scale headless (0.036 kg m/s, tests/test_live_spatial.py).
+        # arm's momentum scale headless (0.036 kg m/s, tests/session/test_live_spatial.py).
         assert np.abs(L).max() < 3e-2 * model.arm_mass * s.snapshot().settings.target_speed
         app.scene.set_initial_camera()
         page.mouse.move(5, 5)
@@ -153,7 +150,7 @@ def test_boom7_r1_pose_target_turns_the_hand_with_the_rotation_rings(boom_app: R
     and a pose set through the call the handle makes is reached by the simulated arm."""
     import pinocchio as pin
 
-    from tests.test_orientation_target import angle_deg, rns_walk
+    from tests.support.poses import angle_deg, rns_walk
 
     app, s = boom_app, boom_app.session
     with browser_page(app.server, width=1400, height=900) as page:

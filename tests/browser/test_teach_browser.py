@@ -25,10 +25,9 @@ from rns_viz.viz.scene.ghost import Ghost
 from rns_viz.viz.scene.player_export import PLAYER_URL, RECORDING_NAME
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import (
+from tests.support.browser import (
     ARTIFACTS,
     CHROMIUM,
-    browser_marks,
     browser_page,
     chromium_flags,
     dismiss_notifications,
@@ -41,8 +40,6 @@ from tests.browser import (
     wait_for_nodes,
     wait_until,
 )
-
-pytestmark = browser_marks
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.defaults import KICK_LEVER_M, defaults_for
+from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
 from rns_viz.viz.panels.base_panel import kick_weights
@@ -18,13 +18,6 @@ PEAK_N = defaults_for("boom7").kick_range_N  # the slider's end (20 N)
 @pytest.fixture(scope="module")
 def turns() -> tuple[bool, ...]:
     return FsmsModel.from_key("boom7").base_rotational
-
-
-def test_the_weights_are_the_force_on_translations_and_its_moment_on_rotations(turns: tuple[bool, ...]) -> None:
-    assert turns == (False, False, False, True, True, True)  # x y z, then rx ry rz
-    assert kick_weights(turns, None) == (1.0, 1.0, 1.0, KICK_LEVER_M, KICK_LEVER_M, KICK_LEVER_M)
-    assert kick_weights(turns, 1) == (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)
-    assert kick_weights(turns, 5) == (0.0, 0.0, 0.0, 0.0, 0.0, KICK_LEVER_M)
 
 
 @pytest.mark.parametrize("index", [0, 1, 2, 3, 4, 5, None], ids=["x", "y", "z", "rx", "ry", "rz", "all"])

@@ -10,7 +10,7 @@ import pytest
 
 from rns_viz.live.loop.session import Session
 from rns_viz.live.teaching.lessons import LESSONS
-from tests.app_helpers import run_lesson
+from tests.support.app_helpers import run_lesson
 
 
 @pytest.fixture(scope="module")

@@ -15,8 +15,8 @@ from rns_viz.live.loop.session import Session
 SIDEWAYS = (0.0, 1.0, 0.0, 0.0, 0.0, 0.0)  # a kick along y: the boom's first bending mode
 
 
-def test_a_kick_is_suppressed_in_all_six_modes_and_the_shadow_keeps_swinging(boom: Session) -> None:
-    s = boom
+def test_a_kick_is_suppressed_in_all_six_modes_and_the_shadow_keeps_swinging(boom7_session: Session) -> None:
+    s = boom7_session
     assert s.snapshot().settings.law == "acceleration" and s.snapshot().readouts.rns_dim == 1
     s.kick(5.0, direction=SIDEWAYS)
     s.advance(0.3)
@@ -34,8 +34,8 @@ def test_a_kick_is_suppressed_in_all_six_modes_and_the_shadow_keeps_swinging(boo
     assert np.allclose(arrays["xb"], np.linalg.norm(np.stack([arrays[f"xb_{i}"] for i in (1, 2, 3)]), axis=0))
 
 
-def test_scrubbing_the_reactionless_path_moves_the_hand_and_not_the_boom(boom: Session) -> None:
-    s = boom
+def test_scrubbing_the_reactionless_path_moves_the_hand_and_not_the_boom(boom7_session: Session) -> None:
+    s = boom7_session
     ee0 = s.state.model.ee_position(s.snapshot().q[6:])
     lo, hi = s.snapshot().sigma_range  # type: ignore[misc]
     s.scrub(0.5 * lo)  # about 4 cm of hand motion along the path, at the default u-bar speed
@@ -53,8 +53,8 @@ def test_scrubbing_the_reactionless_path_moves_the_hand_and_not_the_boom(boom: S
     assert notes and "nearest point (" in notes[0].body and notes[0].body.count(",") >= 2
 
 
-def test_forces_only_tracks_a_3d_target_and_an_unserved_selection_is_refused(boom: Session) -> None:
-    s = boom
+def test_forces_only_tracks_a_3d_target_and_an_unserved_selection_is_refused(boom7_session: Session) -> None:
+    s = boom7_session
     s.set_selection((True, True, True, False, False, False))
     s.advance(0.01)
     told = [n for n in s.pop_notices() if n.title == "Selection S"]

@@ -1,5 +1,5 @@
-"""What the app tests share: a stepped app, a real-time app, a stepped session, a lesson driver, a
-handle's uuid, waiting for queued commands."""
+"""What the app and session tests share: a stepped app, a real-time app, a stepped session, boom7 kicked
+in every row, a lesson driver, a handle's uuid, waiting for queued commands."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import Any
 
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser import wait_until
+from tests.support.browser import wait_until
 
 
 def stepped_app(model: str) -> Iterator[RnsApp]:
@@ -31,6 +31,23 @@ def stepped_session(model: str, background_s: float = 120.0) -> Iterator[Session
     s = Session(model, realtime=False)
     assert s.wait_background(background_s)
     yield s
+    s.stop()
+
+
+BOOM7_KICK_N = 5.0  # N: the app's kick, along the tip's y and z
+
+
+def kicked_boom7() -> Iterator[tuple[Session, dict[float, object]]]:
+    """boom7 kicked sideways (y and z) with suppression on, 0.6 s stepped; every published snapshot by time."""
+    s = Session("boom7", realtime=False)
+    assert s.wait_background(120.0)
+    s.kick(BOOM7_KICK_N, direction=(0.0, 1.0, 1.0, 0.0, 0.0, 0.0))
+    snaps = {}
+    for _ in range(60):
+        s.advance(0.01)
+        snap = s.snapshot()
+        snaps[snap.t] = snap
+    yield s, snaps
     s.stop()
 
 

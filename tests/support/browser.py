@@ -15,11 +15,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import viser
 from playwright.sync_api import Browser, Page, sync_playwright
 
-from rns_viz.viz.server.app import RnsApp, start_app
+from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
+from tests.support.repo import REPO
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_FLAGS = [
@@ -52,7 +54,7 @@ for (const context of [WebGLRenderingContext, WebGL2RenderingContext]) {
   }
 }
 """
-ARTIFACTS = Path(__file__).resolve().parent.parent / "artifacts"
+ARTIFACTS = REPO / "artifacts"
 SKIP_REASON = f"real-browser test needs Debian chromium at {CHROMIUM} (apt-get install chromium)"
 
 
@@ -227,7 +229,52 @@ def screenshot(page: Page, name: str) -> Path:
 def each_model_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
     """The app of each bundled planar model on a free port (import this fixture into a test module). The 3R's
     pass over the same page is on demand (``-m docs``, with its screenshots): the default run drives the 3R's
-    page in the lesson, scene and plots browser tests and its app through the protocol (tests/test_app.py)."""
+    page in the lesson, scene and plots browser tests and its app through the protocol (tests/app/test_app.py)."""
     app = start_app(request.param, port=0, verbose=False)
     yield app
     app.stop()
+
+
+def click_track(page: Page, label: str, fraction: float) -> None:
+    """Click the track of the slider labelled ``label`` at ``fraction`` of its width (one action, not many
+    key presses: a software-rendered page answers each input only after its next frame)."""
+    row = page.get_by_text(label, exact=True).locator("xpath=ancestor::*[.//*[@role='slider']][1]")
+    thumb = row.get_by_role("slider")
+    thumb.scroll_into_view_if_needed()
+    track = thumb.locator("xpath=ancestor::div[contains(@class, 'mantine-Slider-root')][1]")
+    box = track.bounding_box()
+    assert box is not None
+    page.mouse.click(box["x"] + fraction * box["width"], box["y"] + 0.5 * box["height"])
+
+
+# Screen position (px) of a point on a scene node's local x axis, ``offset`` m from its origin: the
+# client's camera matrices applied to the node's world matrix (three.js, column-major).
+PROJECT = """([name, offset]) => {
+  const m = window.__viserMutable, obj = m.nodeRefFromName[name], cam = m.camera;
+  obj.updateWorldMatrix(true, false);
+  cam.updateMatrixWorld();
+  const e = obj.matrixWorld.elements;
+  const p = [e[12] + offset * e[0], e[13] + offset * e[1], e[14] + offset * e[2], 1];
+  const mul = (M, v) => [0, 1, 2, 3].map((r) => M[r] * v[0] + M[4 + r] * v[1] + M[8 + r] * v[2] + M[12 + r] * v[3]);
+  const c = mul(cam.projectionMatrix.elements, mul(cam.matrixWorldInverse.elements, p));
+  const rect = m.canvas.getBoundingClientRect();
+  return [rect.left + ((c[0] / c[3] + 1) / 2) * rect.width, rect.top + ((1 - c[1] / c[3]) / 2) * rect.height];
+}"""
+
+
+DRAG_STEP_S = 0.1  # s between the drag's ten mouse moves: a hand's pace (a whole drag in about a second)
+
+
+def drag_handle_along_x(page: Page, app: RnsApp, pixels: float) -> None:
+    """Press on the handle's x arrow (30 % of its length out), move ``pixels`` along it in about a second
+    (not at the pace of the page's frames, which depends on how fast the machine draws), release."""
+    x0, y0 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.3 * app.handle.scale])
+    x1, y1 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.6 * app.handle.scale])
+    d = np.array([x1 - x0, y1 - y0]) / max(float(np.hypot(x1 - x0, y1 - y0)), 1e-9)
+    page.mouse.move(x0, y0)
+    page.mouse.down()
+    for k in range(1, 11):
+        page.mouse.move(x0 + d[0] * pixels * k / 10, y0 + d[1] * pixels * k / 10)
+        wait_for_frames(page, 2)
+        page.wait_for_timeout(1000 * DRAG_STEP_S)
+    page.mouse.up()

@@ -2,9 +2,9 @@
 
 Always run: composition from a stand-in package laid out as example-robot-data is (the arm block of the
 mass matrix equals pinocchio's on the stand-in's own URDF, meshes resolved into the package), and the
-"not installed" path (a refusal naming the install command; the app keeps its model). With the extra
-installed: the real Panda against pinocchio on the package's own panda.urdf, boom7's base numbers, a
-suppressed kick, and the meshes in the scene.
+"not installed" path (a refusal naming the install command). With the extra installed: the real Panda
+against pinocchio on the package's own panda.urdf, boom7's base numbers and a suppressed kick. In the app
+(its model kept without the extra, the meshes in the scene): tests/app/test_boom_panda.py.
 """
 
 from __future__ import annotations
@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-import viser
 
 from rns_viz import robots
 from rns_viz.control import AccelerationLaw, FixedReference
@@ -28,10 +27,6 @@ from rns_viz.rns import restricted_jacobian, rns_projector
 from rns_viz.scenarios import BOOM7_GAINS, BOOM7_KICK, FORCES_ONLY
 from rns_viz.sim import ForcePulse, Simulator
 from rns_viz.viz.panels.model_menu import MODEL_LABELS, ModelMenu, label_of
-from rns_viz.viz.scene.robot import RobotMeshes
-from rns_viz.viz.server.app import start_app
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient, gui_uuid
 
 PANDA = "example-robot-data/panda"
 installed = pytest.mark.skipif(
@@ -161,31 +156,6 @@ def test_without_the_extra_the_model_is_refused_with_the_install_command(not_ins
     assert ModelMenu().key_of(label) == "boom-panda"
 
 
-def test_choosing_it_without_the_extra_keeps_the_app_and_tells_the_operator(not_installed: None) -> None:
-    app = start_app("trep", port=0, realtime=False, verbose=False)
-    told: list[str] = []
-    original = app.connections.notify_by_id
-
-    def record(client_id, title, body, level):  # type: ignore[no-untyped-def]
-        told.append(body)
-        original(client_id, title, body, level)
-
-    app.connections.notify_by_id = record  # type: ignore[method-assign]
-    operator = ProtocolClient(app.port)
-    try:
-        wait_for_clients(app, 1, "the operator")
-        app.session.advance(0.2)
-        operator.set_value(gui_uuid(app.gui.model), label_of("boom-panda"))
-        wait_until(lambda: "SwitchModel" in app.session.pending_commands(), 10.0, "the model switch to be queued")
-        app.session.advance(0.05)
-        wait_until(lambda: any("rns-viz[panda]" in body for body in told), 10.0, "the refusal with the install hint")
-        assert app.session.snapshot().settings.model == "trep" and app.render_thread.is_alive()
-        wait_until(lambda: app.gui.model.value == MODEL_LABELS["trep"], 10.0, "the dropdown to show TREP again")
-    finally:
-        operator.close()
-        app.stop()
-
-
 # ------------------------------------------------------------------ with example-robot-data installed
 @pytest.fixture(scope="module")
 def panda() -> FsmsModel:
@@ -254,22 +224,3 @@ def test_a_kick_is_suppressed_in_all_six_modes(panda: FsmsModel) -> None:
         runs.append(np.abs(x_b[sim.log.column("t") >= 3.0]).max(axis=0))
     on, off = runs
     assert np.all(on <= 0.01 * off)
-
-
-@installed
-def test_the_panda_is_drawn_with_its_meshes(panda: FsmsModel) -> None:
-    """Every visual .dae of the package's Panda is in the scene, under the joint node that moves it."""
-    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    try:
-        robot = RobotMeshes(server, panda)
-        names = [mesh.name for mesh in robot.meshes]
-        for part in ("link0", "link1", "link4", "link7", "hand", "finger"):
-            assert any(f"{part}.dae" in name for name in names), part
-        assert any(name.startswith("/base/") and "panda_link7" in name for name in names)
-        robot.pose(panda.q(panda.spec.default_configuration))
-        ee = robot.ee_position()
-        np.testing.assert_allclose(
-            ee - robot.base_placement().translation, panda.ee_position(panda.spec.default_configuration)
-        )
-    finally:
-        server.stop()

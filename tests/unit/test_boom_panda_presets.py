@@ -1,5 +1,5 @@
 """boom-panda's own presets (boom7's five experiments with the Franka Panda): headless runs that stay
-reactionless where they claim to, the CLI, and the app keeping boom-panda when one is chosen.
+reactionless where they claim to, and the CLI (the app: tests/app/test_boom_panda_presets.py).
 
 Skipped without example-robot-data (pip install 'rns-viz[panda]').
 """
@@ -28,9 +28,6 @@ from rns_viz.scenarios import (
 )
 from rns_viz.sim import Simulator
 from rns_viz.viz.panels.control_panel import BOOM7_PRESETS, PANDA_PRESETS
-from rns_viz.viz.server.app import start_app
-from tests.browser import wait_for_clients, wait_until
-from tests.protocol_client import ProtocolClient, gui_uuid
 
 pytestmark = pytest.mark.skipif(
     not robots.is_installed("example-robot-data/panda"),
@@ -125,25 +122,3 @@ def test_the_cli_runs_a_panda_preset_headless(tmp_path: Path) -> None:
     assert steps >= 500 and len(lines) == steps + 1  # 1 ms steps over 0.5 s, and a header
     header = lines[0].split(",")
     assert "xb_6" in header and "theta_7" in header
-
-
-def test_the_app_serving_boom_panda_shows_its_presets_and_keeps_the_panda() -> None:
-    """The menu shows the Panda's presets instead of boom7's; clicking one loads it on boom-panda."""
-    app = start_app("boom-panda", port=0, realtime=False, verbose=False)
-    operator = ProtocolClient(app.port)
-    try:
-        wait_for_clients(app, 1, "the operator")
-        app.session.advance(0.05)
-        wait_until(lambda: app.gui.presets_panda.visible, 20.0, "the Panda's presets to be shown")
-        assert not app.gui.presets_boom7.visible
-        operator.click(gui_uuid(app.gui.presets_panda), "boom-panda-track")
-        wait_until(lambda: "LoadPreset" in app.session.pending_commands(), 10.0, "the preset to be queued")
-        app.session.advance(0.0)
-        assert app.session.wait_background(120.0)
-        snap = app.session.snapshot()
-        assert snap.settings.model.startswith("boom-panda") and app.session.state.runs.sim.model.n == 7
-        assert app.session.state.runs.sim.model.arm_joint_names[0] == "panda_joint1"
-        assert app.gui.presets_panda.visible and not app.gui.presets_boom7.visible
-    finally:
-        operator.close()
-        app.stop()

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.closed_forms import trep_ee
+from tests.support.oracles.closed_forms import trep_ee
+from tests.support.repo import ASSETS
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:
@@ -82,7 +83,7 @@ def test_bad_arguments_give_one_clear_line(args: list[str], fragment: str, tmp_p
 )
 def test_malformed_urdf_names_file_and_element(tmp_path: Path, urdf: str, fragment: str) -> None:
     (tmp_path / "robot.urdf").write_text(urdf)
-    params = (Path(__file__).parent.parent / "assets" / "trep.toml").read_text()
+    params = (ASSETS / "trep.toml").read_text()
     (tmp_path / "robot.toml").write_text(params.replace('urdf = "trep.urdf"', 'urdf = "robot.urdf"'))
     result = run("info", "--model", str(tmp_path / "robot.toml"))
     assert result.returncode == 2
@@ -91,7 +92,7 @@ def test_malformed_urdf_names_file_and_element(tmp_path: Path, urdf: str, fragme
 
 
 def test_malformed_parameter_file(tmp_path: Path) -> None:
-    params = (Path(__file__).parent.parent / "assets" / "trep.toml").read_text()
+    params = (ASSETS / "trep.toml").read_text()
     bad = tmp_path / "bad.toml"
     bad.write_text(params.replace("stiffness = [[77.9218]]", 'stiffness = [["stiff"]]'))
     result = run("info", "--model", str(bad))

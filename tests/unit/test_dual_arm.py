@@ -18,7 +18,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES
 from rns_viz.scenarios import DUAL_SCENARIOS, TREP2_CIRCLE, TREP2_GAINS, run_scenario
 from rns_viz.sim import Simulator
-from tests.oracles.mujoco_replay import HeldOverEachStep, replay
+from tests.support.oracles.mujoco_replay import HeldOverEachStep, replay
 
 TASK = ["joint1", "joint2"]
 COMP = ["c_joint1", "c_joint2"]

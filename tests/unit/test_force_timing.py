@@ -21,8 +21,8 @@ from rns_viz.control import AccelerationLaw, DampNullMotion, Gains
 from rns_viz.model import FsmsModel
 from rns_viz.sim import ForcePulse, Simulator
 from rns_viz.sim.disturbance import stage_forces
+from tests.support.repo import ASSETS
 
-ASSETS = Path(__file__).resolve().parents[1] / "assets"
 DT = 1e-3
 PULSE = ForcePulse(start=0.0203, duration=0.05, peak=(2.0,))  # starts 0.3 ms into a step
 

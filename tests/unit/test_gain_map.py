@@ -28,6 +28,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.paths import trace_paths
 from rns_viz.scenarios import FIG12_GAINS, FIG12_KICK_AT_S, run_scenario
 from rns_viz.sim import ForcePulse, SimulationDiverged, Simulator
+from tests.support.repo import ASSETS
 
 RNG = np.random.default_rng(10)
 
@@ -292,7 +293,7 @@ def test_gain_map_figure_is_drawn(tmp_path: Path) -> None:
 
 def test_a_state_that_is_not_at_rest_is_refused(tmp_path: Path) -> None:
     """Gravity along the base axis loads the spring: x_b = 0 is no equilibrium to linearise about."""
-    assets = Path(__file__).resolve().parent.parent / "assets"
+    assets = ASSETS
     text = (assets / "trep.toml").read_text()
     text = text.replace("gravity_m_per_s2 = [0.0, 0.0, 0.0]", "gravity_m_per_s2 = [-9.81, 0.0, 0.0]")
     text = text.replace('urdf = "trep.urdf"', f'urdf = "{(assets / "trep.urdf").as_posix()}"')

@@ -3,12 +3,12 @@ model; only the viz layer imports viser). On failure, ``lint-imports`` prints th
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 from importlinter.cli import EXIT_STATUS_SUCCESS, lint_imports
 
-PYPROJECT = Path(__file__).resolve().parents[1] / "pyproject.toml"
+from tests.support.repo import REPO
+
+PYPROJECT = REPO / "pyproject.toml"
 
 
 def test_import_contracts_are_kept(capsys: pytest.CaptureFixture[str]) -> None:

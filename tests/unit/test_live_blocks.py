@@ -178,27 +178,7 @@ def test_a_kick_reaches_both_runs_alike_without_suppression(trep: FsmsModel) -> 
     assert abs(runs.sim.q[0]) > 1e-3 and np.allclose(runs.sim.q, runs.shadow.q, atol=1e-12)
 
 
-# ---------------------------------------------------------------- inputs that wait or are moved
-def test_play_right_after_reset_waits_for_the_path_and_then_runs() -> None:
-    from rns_viz.live.loop.session import Session
-
-    s = Session("trep", realtime=False)
-    try:
-        s.load_preset("fig10-on")
-        s.advance(0.001)  # the command is applied: the preset is built in the background
-        assert s.wait_background() and s.snapshot().settings.preset == "fig10-on"
-        s.play_slow()  # leaving a preset, the path is computed anew: the play waits for it
-        s.advance(0.002)
-        assert any(n.title == "Waiting for the path" for n in s.pop_notices())
-        assert s.wait_background()
-        theta0 = s.state.runs.theta.copy()
-        s.advance(1.0)
-        assert s.snapshot().mode.startswith("quintic along the path")
-        assert np.linalg.norm(s.state.runs.theta - theta0) > 0.05  # rad: the arm moves along the path
-    finally:
-        s.stop()
-
-
+# ---------------------------------------------------------------- inputs that are moved
 def test_a_target_off_the_path_is_moved_onto_it_and_said(trep: FsmsModel, trep_table) -> None:  # type: ignore[no-untyped-def]
     op = Operator(trep, trep.spec.default_configuration, 30.0, 0.5)
     op.accept_table(trep_table, 1e-6)

@@ -7,7 +7,7 @@ import pytest
 
 from rns_viz.model import FsmsModel
 from rns_viz.params import ModelFileError, load_spec, param_path_for
-from tests.closed_forms import r3_ee, r3_hbm, trep_ee, trep_hbm
+from tests.support.oracles.closed_forms import r3_ee, r3_hbm, trep_ee, trep_hbm
 
 RNG = np.random.default_rng(7)
 

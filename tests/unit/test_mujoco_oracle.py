@@ -1,4 +1,4 @@
-"""Validation of the MuJoCo replay oracle (tests/oracles/mujoco_replay.py) on its own.
+"""Validation of the MuJoCo replay oracle (tests/support/oracles/mujoco_replay.py) on its own.
 
 The oracle must agree with a plain RK4 of the FSMS equations of motion written here with
 pinocchio's ``aba`` (torques and base forces held over each step, springs and dampers evaluated at
@@ -19,7 +19,8 @@ import pinocchio as pin
 import pytest
 
 from rns_viz.model import FsmsModel
-from tests.oracles.mujoco_replay import INERTIA_FLOOR, MujocoPlant, build_model, replay, simulate
+from tests.support.oracles.mujoco_replay import INERTIA_FLOOR, MujocoPlant, build_model, replay, simulate
+from tests.support.repo import REPO
 
 DT = 1e-3
 STEPS = 2000
@@ -328,7 +329,7 @@ def test_trep_small_free_oscillation_period(trep: FsmsModel) -> None:
 
 # -- hygiene ---------------------------------------------------------------------------------------
 def test_library_never_imports_mujoco() -> None:
-    package = Path(__file__).resolve().parent.parent / "rns_viz"
+    package = REPO / "rns_viz"
     pattern = re.compile(r"^\s*(import|from)\s+mujoco\b", re.MULTILINE)
     offenders = [str(p) for p in package.rglob("*.py") if pattern.search(p.read_text())]
     assert not offenders, f"rns_viz must not import mujoco: {offenders}"

@@ -39,6 +39,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField, path_family
 from rns_viz.scenarios import SCENARIOS, run_scenario
 from rns_viz.sim import ForcePulse, SimulationDiverged, Simulator, native
+from tests.support.repo import ASSETS
 
 if not native.available():
     if os.environ.get("RNS_VIZ_REQUIRE_NATIVE") == "1":
@@ -47,7 +48,6 @@ if not native.available():
 
 RNG = np.random.default_rng(11)
 NATIVE_LAW_TOLERANCE = 1e-12  # relative, per logged column and state entry
-ASSETS = Path(__file__).resolve().parents[1] / "assets"
 
 
 def pair(model: FsmsModel, law: AccelerationLaw, **kw: object) -> tuple[Simulator, Simulator]:

@@ -2,23 +2,20 @@
 (Eq. 24's J-bar = J P_RNS) and the orientation as a secondary task in the RNS directions that leave the
 hand still (task priority). r = 1 reaches a full pose; forces only (n - r = 4) tracks one rotational DOF
 by least squares without disturbing the position; the secondary term is checked against finite
-differences; bad quaternions are refused and the simulation runs on.
+differences. The simulated arm and bad quaternions: tests/session/ and tests/app/test_orientation_target.py.
 """
 
 from __future__ import annotations
-
-import time
-from collections.abc import Iterator
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from rns_viz.live.loop.session import Session
 from rns_viz.live.operator.moving_references import ResolvedRate
 from rns_viz.live.operator.operator import orientation_note
 from rns_viz.model import FsmsModel
 from rns_viz.rns import rns_projector
+from tests.support.poses import angle_deg, coupling, rns_walk
 
 R1 = (True, False, False, False, False, False)
 FORCES = (True, True, True, False, False, False)
@@ -26,24 +23,6 @@ FORCES = (True, True, True, False, False, False)
 
 def boom(flags: tuple[bool, ...]) -> FsmsModel:
     return FsmsModel.from_name("boom7").with_selection([int(f) for f in flags])
-
-
-def coupling(model: FsmsModel, theta: np.ndarray) -> np.ndarray:
-    """S H_bm at theta (kg m)."""
-    return model.mass_matrix(model.q(theta))[model.selected, model.m :]
-
-
-def rns_walk(model: FsmsModel, theta: np.ndarray, seed: int, steps: int = 300) -> np.ndarray:
-    """A configuration reached by a random reactionless motion: its pose is reachable without reaction."""
-    z = np.random.default_rng(seed).normal(size=model.n)
-    theta = np.array(theta, dtype=float)
-    for _ in range(steps):
-        theta = theta + 1e-3 * rns_projector(coupling(model, theta)) @ z
-    return theta
-
-
-def angle_deg(A: np.ndarray, B: np.ndarray) -> float:
-    return float(np.degrees(np.linalg.norm(pin.log3(A @ B.T))))
 
 
 def run(rr: ResolvedRate, steps: int) -> tuple[np.ndarray, float]:
@@ -149,99 +128,3 @@ def test_the_rotational_dof_offered_follow_n_minus_r(r: int, free: int) -> None:
         assert "not offered" in note and f"n − r = {7 - r}" in note
         with pytest.raises(ValueError):
             rr.set_orientation(True)
-
-
-@pytest.fixture
-def live() -> Iterator[Session]:
-    s = Session("boom7", realtime=False)
-    assert s.wait_background(120.0)
-    yield s
-    s.stop()
-
-
-def test_live_pose_target_the_arm_follows_and_bad_quaternions_are_refused(live: Session) -> None:
-    s = live
-    s.set_selection(R1)
-    s.advance(0.01)
-    view = s.snapshot().orientation
-    assert view is not None and view.on and view.offered and "3 of 3" in view.note
-    model = s.state.model
-    theta0 = s.snapshot().q[6:]
-    goal = rns_walk(model, theta0, seed=4, steps=200)
-    rr = s.state.operator.rr  # type: ignore[union-attr]
-    x_goal, R_goal = rr.ee(goal), rr.ee_rotation(goal)
-    wxyz = pin.Quaternion(R_goal)
-    for bad in ((np.nan, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0), (1.0, 0.0, 0.0)):
-        with pytest.raises(ValueError, match="quaternion"):
-            s.set_target(tuple(x_goal), True, wxyz=bad)
-    s.set_target(tuple(x_goal), True, wxyz=(wxyz.w, wxyz.x, wxyz.y, wxyz.z))
-    s.advance(4.0)
-    snap = s.snapshot()
-    assert not snap.paused and snap.diverged is None and snap.t > 4.0  # the bad inputs left it running
-    theta = snap.q[6:]
-    assert np.linalg.norm(rr.ee(theta) - x_goal) < 2e-3  # the simulated arm, not only the reference
-    assert angle_deg(rr.ee_rotation(theta), R_goal) < 1.0
-    # only the axial force (S1) is selected: that coordinate stays still, the free ones are excited
-    assert abs(snap.q[0]) < 1e-5 < np.abs(snap.q[1:6]).max()  # m, rad
-    s.track_orientation(False)
-    s.advance(0.01)
-    assert s.snapshot().orientation.on is False  # type: ignore[union-attr]
-
-
-def test_at_r_5_sigma_jbar_is_the_second_singular_value_and_orientation_is_refused(live: Session) -> None:
-    s = live
-    s.set_selection((True,) * 5 + (False,))
-    s.advance(0.01)
-    s.pop_notices()
-    snap = s.snapshot()
-    model = s.state.model
-    theta = snap.q[6:]
-    sv = np.linalg.svd(model.ee_jacobian(theta) @ rns_projector(coupling(model, theta)), compute_uv=False)
-    assert sv[2] < 1e-9 * sv[0]  # rank n - r = 2 < 3 task rows
-    assert snap.readouts.sigma_jbar == pytest.approx(sv[1], rel=1e-9) and sv[1] > 0.0
-    assert snap.orientation is not None and not snap.orientation.offered and "not offered" in snap.orientation.note
-    s.track_orientation(True)
-    s.advance(0.01)
-    refused = [n for n in s.pop_notices() if n.title == "Input not applied"]
-    assert refused and "not offered" in refused[0].body
-    assert not s.snapshot().paused
-
-
-def test_bad_quaternions_from_a_client_are_told_and_the_simulation_runs_on() -> None:
-    """The handle's drag with a NaN or zero quaternion, as a client could send it (tests/protocol_client.py)."""
-    from rns_viz.viz.server.app import TARGET_HANDLE
-    from tests.app_helpers import stepped_app
-    from tests.browser import wait_for_clients, wait_until
-    from tests.protocol_client import ProtocolClient
-
-    apps = stepped_app("boom7")
-    app = next(apps)
-    s = app.session
-    s.set_selection(R1)
-    s.advance(0.01)
-    wait_until(lambda: app.controls.pose_target, 20.0, "the pose handle")
-    ws = ProtocolClient(app.port, decode=True)
-    try:
-        wait_for_clients(app, 1, "the websocket client")
-        before = np.array(s.snapshot().target, dtype=float)
-        goal_R = s.state.operator.rr.goal_R.copy()  # type: ignore[union-attr]
-        lifted = before + app.controls.target_lift + np.array([0.02, 0.0, 0.0])
-        for bad in ((np.nan, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0)):
-            told = ws.types["NotificationShowMessage"]
-            # mid-drag updates (at a drag's end viser calls back once more with the handle as it is then)
-            ws.drag(TARGET_HANDLE, tuple(lifted), "update", wxyz=bad)
-            wait_until(lambda told=told: ws.types["NotificationShowMessage"] > told, 10.0, "a notice")
-            # the refused drag sends the handle home (render thread); wait for it before the next drag,
-            # whose callback would otherwise read the handle's pose as the renderer set it
-            wait_until(lambda: not app.controls._handle_home_requested, 10.0, "the handle sent home")
-            time.sleep(0.5)  # the render frame that took the request writes the handle's pose (30 Hz frames)
-        assert "DragTarget" not in s.pending_commands()  # refused before anything was queued
-        t0 = s.snapshot().t
-        s.advance(0.5)
-        snap = s.snapshot()
-        assert not snap.paused and snap.diverged is None and snap.t == pytest.approx(t0 + 0.5)
-        assert np.allclose(snap.target, before)  # the target in force is untouched
-        assert np.allclose(s.state.operator.rr.goal_R, goal_R)  # type: ignore[union-attr]
-    finally:
-        ws.close()
-        apps.close()

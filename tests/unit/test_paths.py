@@ -8,7 +8,7 @@ from scipy.optimize import brentq
 
 from rns_viz.model import FsmsModel
 from rns_viz.paths import default_seeds, path_family, reactionless_reachable_set, trace_paths
-from tests.closed_forms import TREP_A, TREP_B, r3_ee, r3_wxcm, trep_ee, trep_hbm, trep_wxcm
+from tests.support.oracles.closed_forms import TREP_A, TREP_B, r3_ee, r3_wxcm, trep_ee, trep_hbm, trep_wxcm
 
 TREP_RANGE = 2 * (TREP_A + TREP_B)  # max - min of w x_cm over the workspace
 

@@ -3,7 +3,7 @@
 Every rank-loss marker it draws is a configuration where sigma_min(S H_bm) <= 1e-9 of the most coupled
 ||S H_bm||, recomputed here from the model, and motion along the kernel there gives no coupling; the
 markers and the arm's dot land on the picture where their joint angles are (read back from the
-pixels); the app shows the inset with the sentence on why, and hides it for a model without one.
+pixels). In the app: tests/app/test_rank_inset.py.
 """
 
 from __future__ import annotations
@@ -11,12 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.teaching.rank_view import RANK_HINT, inset_slice, rank_inset
+from rns_viz.live.teaching.rank_view import inset_slice, rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.rank import kernel_coupling
 from rns_viz.viz.panels.rank_inset import DOT_COLOUR, InsetPicture, dot_pixel, draw_inset, with_dot
-from rns_viz.viz.server.app import start_app
-from tests.browser import wait_until
 
 PLANES = [("trep", np.array([1.2, -0.4]), 4), ("planar3r", np.array([0.0, 0.5, -1.0]), 4)]
 
@@ -63,21 +61,3 @@ def test_markers_and_the_dot_land_where_their_joint_angles_are(name: str, theta:
     assert _is_colour(image[round(row), round(col)], DOT_COLOUR, tol=0)
     changed = np.argwhere(np.any(image != picture.image, axis=2))
     assert np.all(np.hypot(changed[:, 0] - row, changed[:, 1] - col) <= 7.0)  # only the dot (and its rim)
-
-
-def test_the_app_shows_the_inset_with_why_and_hides_it_without_one() -> None:
-    app = start_app("trep", port=0, realtime=False, verbose=False)
-    try:
-        panel, s = app.rank_inset, app.session
-        s.advance(0.05)
-        assert not panel.folder.visible  # the box starts unticked
-        app.view.boxes["rank"].value = True
-        wait_until(lambda: panel.updates > 0 and panel.folder.visible, 20.0, "the inset")
-        assert RANK_HINT in panel.text.content
-        snap = s.snapshot()
-        assert panel.theta is not None and np.allclose(panel.theta, snap.q[1:])
-        s.switch_model("trep2")
-        s.advance(0.01)
-        wait_until(lambda: not panel.folder.visible, 20.0, "the inset hidden for trep2")
-    finally:
-        app.stop()

@@ -11,7 +11,7 @@ from rns_viz.control import FixedReference, Gains, JointServo
 from rns_viz.model import FsmsModel
 from rns_viz.scenarios import PLANAR3R_KICK, SCENARIOS, run_scenario
 from rns_viz.sim import ForcePulse, Simulator
-from tests.oracles.mujoco_replay import replay
+from tests.support.oracles.mujoco_replay import replay
 
 Runs = Callable[[str], Simulator]
 

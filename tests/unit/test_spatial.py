@@ -36,7 +36,7 @@ from rns_viz.scenarios import (
 )
 from rns_viz.sim import Simulator
 from rns_viz.sim.plant import Plant
-from tests.oracles.mujoco_replay import HeldOverEachStep, replay
+from tests.support.oracles.mujoco_replay import HeldOverEachStep, replay
 
 RUN_S = BOOM7_START_S + BOOM7_MOVE_S + 0.1  # s: every motion is over by then
 # The boom of boom7.toml: aluminium tube, E, G in Pa, length, outer diameter and wall in m.

@@ -1,0 +1,86 @@
+"""boom-panda in the app: without the extra the app keeps its model and tells the operator; with it, the
+Panda's meshes are drawn in the scene (its model and physics: tests/unit/test_boom_panda.py)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import viser
+
+from rns_viz import robots
+from rns_viz.model import FsmsModel
+from rns_viz.viz.panels.model_menu import MODEL_LABELS, label_of
+from rns_viz.viz.scene.robot import RobotMeshes
+from rns_viz.viz.server.app import start_app
+from tests.support.browser import wait_for_clients, wait_until
+from tests.support.protocol_client import ProtocolClient, gui_uuid
+
+PANDA = "example-robot-data/panda"
+
+
+installed = pytest.mark.skipif(
+    not robots.is_installed(PANDA), reason="example-robot-data is not installed (pip install 'rns-viz[panda]')"
+)
+
+
+@pytest.fixture
+def not_installed(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """example-robot-data as if absent: the arm names a distribution that does not exist."""
+    arm = robots.packaged_arm(PANDA)
+    monkeypatch.setitem(robots.PACKAGED_ARMS, PANDA, replace(arm, distribution="rns-viz-no-such-distribution"))
+    robots.is_installed.cache_clear()
+    yield
+    robots.is_installed.cache_clear()
+
+
+def test_choosing_it_without_the_extra_keeps_the_app_and_tells_the_operator(not_installed: None) -> None:
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    told: list[str] = []
+    original = app.connections.notify_by_id
+
+    def record(client_id, title, body, level):  # type: ignore[no-untyped-def]
+        told.append(body)
+        original(client_id, title, body, level)
+
+    app.connections.notify_by_id = record  # type: ignore[method-assign]
+    operator = ProtocolClient(app.port)
+    try:
+        wait_for_clients(app, 1, "the operator")
+        app.session.advance(0.2)
+        operator.set_value(gui_uuid(app.gui.model), label_of("boom-panda"))
+        wait_until(lambda: "SwitchModel" in app.session.pending_commands(), 10.0, "the model switch to be queued")
+        app.session.advance(0.05)
+        wait_until(lambda: any("rns-viz[panda]" in body for body in told), 10.0, "the refusal with the install hint")
+        assert app.session.snapshot().settings.model == "trep" and app.render_thread.is_alive()
+        wait_until(lambda: app.gui.model.value == MODEL_LABELS["trep"], 10.0, "the dropdown to show TREP again")
+    finally:
+        operator.close()
+        app.stop()
+
+
+# ------------------------------------------------------------------ with example-robot-data installed
+@pytest.fixture(scope="module")
+def panda() -> FsmsModel:
+    return FsmsModel.from_name("boom-panda")
+
+
+@installed
+def test_the_panda_is_drawn_with_its_meshes(panda: FsmsModel) -> None:
+    """Every visual .dae of the package's Panda is in the scene, under the joint node that moves it."""
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        robot = RobotMeshes(server, panda)
+        names = [mesh.name for mesh in robot.meshes]
+        for part in ("link0", "link1", "link4", "link7", "hand", "finger"):
+            assert any(f"{part}.dae" in name for name in names), part
+        assert any(name.startswith("/base/") and "panda_link7" in name for name in names)
+        robot.pose(panda.q(panda.spec.default_configuration))
+        ee = robot.ee_position()
+        np.testing.assert_allclose(
+            ee - robot.base_placement().translation, panda.ee_position(panda.spec.default_configuration)
+        )
+    finally:
+        server.stop()

@@ -1,0 +1,10 @@
+"""boom7's lesson table: three lessons, the third on forces only (each lesson walked in a session:
+tests/session/test_lessons_boom.py)."""
+
+from __future__ import annotations
+
+from rns_viz.live.teaching.lessons import LESSONS
+
+
+def test_boom7_has_three_lessons() -> None:
+    assert [lesson.start.model for lesson in LESSONS["boom7"]] == ["boom7", "boom7", "boom7#S=111000"]
