@@ -1,5 +1,6 @@
 """What every level of the tests shares: markers applied by folder, and the bundled models, each loaded once
-per test session.
+per test session (``trep``, ``planar3r``, ``boom7``, ``trep2``, ``boom_panda``, or ``bundled_model(name)``
+for a parametrised name; boom-panda skips without its extra, and ``panda_not_installed`` hides the extra).
 
 Folders are levels: ``unit`` (pure functions and physics: the developer's loop, ``python -m pytest
 tests/unit``), ``session`` (a headless Session), ``app`` (a viser server, protocol clients), ``browser``
@@ -10,11 +11,13 @@ tests/support/browser.py). The fixtures of one level live in its folder's confte
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
+from rns_viz import robots
 from rns_viz.model import FsmsModel
 from rns_viz.params import missing_extra
 
@@ -83,3 +86,14 @@ def trep2(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
 def boom_panda(bundled_model: Callable[[str], FsmsModel]) -> FsmsModel:
     """The Franka Panda on boom7's boom; skips without example-robot-data (rns-viz[panda])."""
     return bundled_model("boom-panda")
+
+
+@pytest.fixture
+def panda_not_installed(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """example-robot-data as if absent: boom-panda's arm names a distribution that does not exist."""
+    panda = "example-robot-data/panda"
+    arm = robots.packaged_arm(panda)
+    monkeypatch.setitem(robots.PACKAGED_ARMS, panda, replace(arm, distribution="rns-viz-no-such-distribution"))
+    robots.is_installed.cache_clear()
+    yield
+    robots.is_installed.cache_clear()

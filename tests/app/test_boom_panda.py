@@ -3,9 +3,6 @@ Panda's meshes are drawn in the scene (its model and physics: tests/unit/test_bo
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from dataclasses import replace
-
 import numpy as np
 import pytest
 import viser
@@ -26,17 +23,7 @@ installed = pytest.mark.skipif(
 )
 
 
-@pytest.fixture
-def not_installed(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """example-robot-data as if absent: the arm names a distribution that does not exist."""
-    arm = robots.packaged_arm(PANDA)
-    monkeypatch.setitem(robots.PACKAGED_ARMS, PANDA, replace(arm, distribution="rns-viz-no-such-distribution"))
-    robots.is_installed.cache_clear()
-    yield
-    robots.is_installed.cache_clear()
-
-
-def test_choosing_it_without_the_extra_keeps_the_app_and_tells_the_operator(not_installed: None) -> None:
+def test_choosing_it_without_the_extra_keeps_the_app_and_tells_the_operator(panda_not_installed: None) -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False)
     told: list[str] = []
     original = app.connections.notify_by_id
@@ -62,25 +49,20 @@ def test_choosing_it_without_the_extra_keeps_the_app_and_tells_the_operator(not_
 
 
 # ------------------------------------------------------------------ with example-robot-data installed
-@pytest.fixture(scope="module")
-def panda() -> FsmsModel:
-    return FsmsModel.from_name("boom-panda")
-
-
 @installed
-def test_the_panda_is_drawn_with_its_meshes(panda: FsmsModel) -> None:
+def test_the_panda_is_drawn_with_its_meshes(boom_panda: FsmsModel) -> None:
     """Every visual .dae of the package's Panda is in the scene, under the joint node that moves it."""
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:
-        robot = RobotMeshes(server, panda)
+        robot = RobotMeshes(server, boom_panda)
         names = [mesh.name for mesh in robot.meshes]
         for part in ("link0", "link1", "link4", "link7", "hand", "finger"):
             assert any(f"{part}.dae" in name for name in names), part
         assert any(name.startswith("/base/") and "panda_link7" in name for name in names)
-        robot.pose(panda.q(panda.spec.default_configuration))
+        robot.pose(boom_panda.q(boom_panda.spec.default_configuration))
         ee = robot.ee_position()
         np.testing.assert_allclose(
-            ee - robot.base_placement().translation, panda.ee_position(panda.spec.default_configuration)
+            ee - robot.base_placement().translation, boom_panda.ee_position(boom_panda.spec.default_configuration)
         )
     finally:
         server.stop()

@@ -21,8 +21,8 @@ def server() -> Iterator[viser.ViserServer]:
     srv.stop()
 
 
-def test_boom7_draws_a_force_and_a_moment_arrow(server: viser.ViserServer) -> None:
-    scene = FsmsScene(server, FsmsModel.from_name("boom7"))
+def test_boom7_draws_a_force_and_a_moment_arrow(server: viser.ViserServer, boom7: FsmsModel) -> None:
+    scene = FsmsScene(server, boom7)
     assert scene.wrench is not None
     st = scene.style
     f, m = np.array([1.0, 2.0, 0.0]), np.array([0.0, 0.0, 0.5])  # N, N m
@@ -39,8 +39,8 @@ def test_boom7_draws_a_force_and_a_moment_arrow(server: viser.ViserServer) -> No
     assert np.isclose(np.linalg.norm(force[1] - force[0]), st.force_arrow_max)
 
 
-def test_a_planar_model_keeps_its_single_arrow(server: viser.ViserServer) -> None:
-    scene = FsmsScene(server, FsmsModel.from_name("trep"))
+def test_a_planar_model_keeps_its_single_arrow(server: viser.ViserServer, trep: FsmsModel) -> None:
+    scene = FsmsScene(server, trep)
     assert scene.wrench is None
     scene.set_reaction_force(0.5, "arm reaction", (0.5,))
     assert scene.force.visible

@@ -4,7 +4,7 @@ reachable set, target, force and trail (its pure geometry: tests/unit/test_scene
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -38,9 +38,11 @@ def planar_scene(server: viser.ViserServer, planar3r: FsmsModel) -> FsmsScene:
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_scene_builds_with_its_nodes(server: viser.ViserServer, name: str) -> None:
+def test_scene_builds_with_its_nodes(
+    server: viser.ViserServer, name: str, bundled_model: Callable[[str], FsmsModel]
+) -> None:
     server.scene.reset()
-    model = FsmsModel.from_name(name)
+    model = bundled_model(name)
     scene = FsmsScene(server, model)
     base_node = "/beam/plates" if name == "trep" else "/spring/coil"
     for node in (FsmsScene.BASE, FsmsScene.PATHS, FsmsScene.TRAIL, FsmsScene.FORCE, FsmsScene.GRID, base_node):

@@ -17,7 +17,7 @@ from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import wait_until
 
 
-def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp) -> None:
+def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp, trep: FsmsModel) -> None:
     app, s = trep_app, trep_app.session
     assert s.snapshot().settings.suppress
     s.kick(0.8)
@@ -30,7 +30,7 @@ def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp) -> No
     np.testing.assert_allclose(ghost.q, shadow, atol=1e-4)
     # The drawn base node (exaggerated) sits where the shadow's x_b puts it, not the operated one's.
     ex = ghost.exaggeration
-    drawing = FsmsModel.from_name("trep")
+    drawing = trep
     base = pin.SE3(drawing.pin_model.jointPlacements[1])
     expected = base.translation + ex * shadow[0] * (base.rotation @ drawing.base_axes()[0])
     np.testing.assert_allclose(ghost.drawn_base_position(), expected, atol=2e-4 * ex)
@@ -40,7 +40,7 @@ def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp) -> No
     wait_until(lambda: not ghost.root.visible, 5.0, "the ghost to hide")
 
 
-def test_drawn_n_and_force_are_the_models(trep_app: RnsApp) -> None:
+def test_drawn_n_and_force_are_the_models(trep_app: RnsApp, trep: FsmsModel) -> None:
     app, s = trep_app, trep_app.session
     s.play_fast()
     s.advance(0.4)
@@ -48,7 +48,7 @@ def test_drawn_n_and_force_are_the_models(trep_app: RnsApp) -> None:
     teach = app.renderer.teach
     theta = np.round(snap.q[1:], 4)
     wait_until(lambda: teach._theta is not None and np.array_equal(teach._theta, theta), 5.0, "n to be drawn")
-    model = FsmsModel.from_name("trep")
+    model = trep
     H = model.coupling_matrix(model.q(theta))
     assert teach.n is not None and abs(float((H @ teach.n)[0])) < 1e-12  # kg m/s per unit u-bar: no coupling
     np.testing.assert_allclose(teach.n, [H[0, 1], -H[0, 0]], rtol=1e-12)  # Eq. (27)

@@ -5,6 +5,8 @@ Screenshots go to ``artifacts/scene_<model>.png`` for a person to look at.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -39,8 +41,8 @@ def _orange_pixels(png: bytes) -> int:
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_scene_renders_in_chromium(name: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_scene_renders_in_chromium(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     theta0 = model.spec.default_configuration
     with local_server() as server:
         scene = FsmsScene(server, model)

@@ -18,11 +18,6 @@ from rns_viz.scenarios import DUAL_SCENARIOS, LIVE_SCENARIOS
 STEP_S = 0.01  # s between samples of both runs
 
 
-@pytest.fixture(scope="module")
-def trep2() -> FsmsModel:
-    return FsmsModel.from_name("trep2")
-
-
 def drag_and_sample(session: Session, target: tuple[float, float], seconds: float) -> dict[str, np.ndarray]:
     """Drag the target, run ``seconds``, sample x_b and both end effectors (base frame) every STEP_S."""
     model = session.state.model

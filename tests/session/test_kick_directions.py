@@ -16,8 +16,8 @@ PEAK_N = defaults_for("boom7").kick_range_N  # the slider's end (20 N)
 
 
 @pytest.fixture(scope="module")
-def turns() -> tuple[bool, ...]:
-    return FsmsModel.from_key("boom7").base_rotational
+def turns(boom7: FsmsModel) -> tuple[bool, ...]:
+    return boom7.base_rotational
 
 
 @pytest.mark.parametrize("index", [0, 1, 2, 3, 4, 5, None], ids=["x", "y", "z", "rx", "ry", "rz", "all"])

@@ -8,6 +8,12 @@ import pinocchio as pin
 
 from rns_viz.live.loop.session import Session
 from rns_viz.model import FsmsModel
+from rns_viz.sim import Simulator
+
+
+def columns(sim: Simulator, prefix: str, k: int) -> np.ndarray:
+    """The logged columns ``prefix_1 .. prefix_k`` of a simulation, one row per logged step."""
+    return np.column_stack([sim.log.column(f"{prefix}_{i + 1}") for i in range(k)])
 
 
 def independent_reaction(model: FsmsModel, row: dict[str, np.ndarray]) -> float:

@@ -10,8 +10,6 @@ against pinocchio on the package's own panda.urdf, boom7's base numbers and a su
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -80,7 +78,9 @@ def arm_block_oracle(urdf: str | Path, thetas: np.ndarray, n: int) -> list[np.nd
     return out
 
 
-def test_composition_hangs_the_packaged_arm_on_the_mount(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_composition_hangs_the_packaged_arm_on_the_mount(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, boom7: FsmsModel
+) -> None:
     """From a stand-in package: boom7's base kept, its arm gone, the finger fixed, meshes resolved, and
     the arm block of M equals the stand-in's own (the joint-space inertia of an arm does not depend on
     where its base is when nothing moves the base)."""
@@ -89,7 +89,6 @@ def test_composition_hangs_the_packaged_arm_on_the_mount(tmp_path: Path, monkeyp
     path = robots.composed_urdf(ASSETS_DIR / "boom7.urdf", PANDA, share=share)
     assert path.is_relative_to(tmp_path / "cache")
     model = pin.buildModelFromUrdf(str(path))
-    boom7 = FsmsModel.from_name("boom7")
     assert list(model.names)[1:] == [*boom7.spec.base.joints, "panda_joint1", "panda_joint2"]
     root = ET.parse(path).getroot()
     links = {link.get("name") for link in root.iter("link")}
@@ -108,7 +107,9 @@ def test_composition_hangs_the_packaged_arm_on_the_mount(tmp_path: Path, monkeyp
     np.testing.assert_allclose(np.diag(M[:3, :3]), link_mass(ASSETS_DIR / "boom7.urdf", "boom_tip") + 3.25, rtol=1e-12)
 
 
-def test_a_parameter_file_extends_boom7_with_a_packaged_arm(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_parameter_file_extends_boom7_with_a_packaged_arm(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, boom7: FsmsModel
+) -> None:
     """``extends`` takes boom7's tables key by key, ``[model] arm`` composes the URDF (stand-in package)."""
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     share = stand_in_package(tmp_path / "prefix")
@@ -119,7 +120,7 @@ def test_a_parameter_file_extends_boom7_with_a_packaged_arm(tmp_path: Path, monk
         f'arm = "{PANDA}"\nee_frame = "panda_hand"\ndefault_configuration_deg = [10.0, 20.0]\n'
         "[arm]\njoint_damping = [0.1, 0.2]\n"
     )
-    model, boom7 = FsmsModel.from_file(path), FsmsModel.from_name("boom7")
+    model = FsmsModel.from_file(path)
     assert (model.m, model.n, model.name) == (6, 2, "two") and model.arm_joint_names == ("panda_joint1", "panda_joint2")
     np.testing.assert_array_equal(model.K_b, boom7.K_b)
     np.testing.assert_array_equal(model.D_b, boom7.D_b)
@@ -136,17 +137,7 @@ def link_mass(urdf: Path, name: str) -> float:
     return float(link.find("inertial/mass").get("value"))
 
 
-@pytest.fixture
-def not_installed(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """example-robot-data as if absent: the arm names a distribution that does not exist."""
-    arm = robots.packaged_arm(PANDA)
-    monkeypatch.setitem(robots.PACKAGED_ARMS, PANDA, replace(arm, distribution="rns-viz-no-such-distribution"))
-    robots.is_installed.cache_clear()
-    yield
-    robots.is_installed.cache_clear()
-
-
-def test_without_the_extra_the_model_is_refused_with_the_install_command(not_installed: None) -> None:
+def test_without_the_extra_the_model_is_refused_with_the_install_command(panda_not_installed: None) -> None:
     with pytest.raises(ModelFileError, match=r"pip install 'rns-viz\[panda\]'") as caught:
         FsmsModel.from_name("boom-panda")
     assert "boom-panda.toml" in str(caught.value) and "[model] arm" in str(caught.value)
@@ -157,40 +148,34 @@ def test_without_the_extra_the_model_is_refused_with_the_install_command(not_ins
 
 
 # ------------------------------------------------------------------ with example-robot-data installed
-@pytest.fixture(scope="module")
-def panda() -> FsmsModel:
-    return FsmsModel.from_name("boom-panda")
-
-
 @installed
-def test_the_arm_is_the_packages_panda(panda: FsmsModel) -> None:
+def test_the_arm_is_the_packages_panda(boom_panda: FsmsModel) -> None:
     """Arm block of M = pinocchio's on the package's own panda.urdf at the same joint values (fingers at 0)."""
     share = robots.share_dir(robots.packaged_arm(PANDA))
-    assert panda.arm_joint_names == tuple(f"panda_joint{i}" for i in range(1, 8))
+    assert boom_panda.arm_joint_names == tuple(f"panda_joint{i}" for i in range(1, 8))
     rng = np.random.default_rng(7)
-    thetas = rng.uniform(panda.lower, panda.upper, (8, 7))
+    thetas = rng.uniform(boom_panda.lower, boom_panda.upper, (8, 7))
     for theta, oracle in zip(thetas, arm_block_oracle(share / robots.packaged_arm(PANDA).urdf, thetas, 7), strict=True):
-        M = panda.mass_matrix(panda.q(theta, rng.uniform(-1e-3, 1e-3, 6)))
+        M = boom_panda.mass_matrix(boom_panda.q(theta, rng.uniform(-1e-3, 1e-3, 6)))
         np.testing.assert_allclose(M[6:, 6:], oracle, rtol=1e-12, atol=1e-14)
     own = pin.buildModelFromUrdf(str(share / robots.packaged_arm(PANDA).urdf))
-    np.testing.assert_array_equal(panda.lower, own.lowerPositionLimit[:7])
-    np.testing.assert_array_equal(panda.upper, own.upperPositionLimit[:7])
-    assert not np.any(panda.spec.gravity)
+    np.testing.assert_array_equal(boom_panda.lower, own.lowerPositionLimit[:7])
+    np.testing.assert_array_equal(boom_panda.upper, own.upperPositionLimit[:7])
+    assert not np.any(boom_panda.spec.gravity)
 
 
 @installed
-def test_the_boom_is_boom7s(panda: FsmsModel) -> None:
+def test_the_boom_is_boom7s(boom_panda: FsmsModel, boom7: FsmsModel) -> None:
     """K_b, D_b, S and the tip's inertia are boom7's; the arm's first joint sits where boom7's does."""
-    boom7 = FsmsModel.from_name("boom7")
-    np.testing.assert_array_equal(panda.K_b, boom7.K_b)
-    np.testing.assert_array_equal(panda.D_b, boom7.D_b)
-    np.testing.assert_array_equal(panda.spec.base.selection, boom7.spec.base.selection)
-    assert tip_element(panda.spec.urdf_path) == tip_element(boom7.spec.urdf_path)
+    np.testing.assert_array_equal(boom_panda.K_b, boom7.K_b)
+    np.testing.assert_array_equal(boom_panda.D_b, boom7.D_b)
+    np.testing.assert_array_equal(boom_panda.spec.base.selection, boom7.spec.base.selection)
+    assert tip_element(boom_panda.spec.urdf_path) == tip_element(boom7.spec.urdf_path)
     q = np.zeros(13)
-    for m in (panda, boom7):
+    for m in (boom_panda, boom7):
         pin.forwardKinematics(m.pin_model, m.data, q)
     np.testing.assert_allclose(
-        panda.data.oMi[panda.pin_model.getJointId("panda_joint1")].translation,
+        boom_panda.data.oMi[boom_panda.pin_model.getJointId("panda_joint1")].translation,
         boom7.data.oMi[boom7.pin_model.getJointId("joint1")].translation,
         atol=1e-12,
     )
@@ -202,9 +187,9 @@ def tip_element(urdf: Path) -> bytes:
 
 
 @installed
-def test_default_configuration_keeps_forces_only_tracking_away_from_singularity(panda: FsmsModel) -> None:
+def test_default_configuration_keeps_forces_only_tracking_away_from_singularity(boom_panda: FsmsModel) -> None:
     """r = 3 (forces only): sigma_min(J-bar = J P_RNS) at theta_0 is 0.098 m/rad, as boom7's."""
-    model = panda.with_selection(FORCES_ONLY)
+    model = boom_panda.with_selection(FORCES_ONLY)
     theta0 = model.spec.default_configuration
     H = model.coupling_matrix(model.q(theta0))
     J_bar = restricted_jacobian(model.ee_jacobian(theta0), rns_projector(H, np.linalg.pinv(H)))
@@ -212,12 +197,12 @@ def test_default_configuration_keeps_forces_only_tracking_away_from_singularity(
 
 
 @installed
-def test_a_kick_is_suppressed_in_all_six_modes(panda: FsmsModel) -> None:
+def test_a_kick_is_suppressed_in_all_six_modes(boom_panda: FsmsModel) -> None:
     """boom7's six-direction kick: with (15) each deflection over 3-3.5 s is below 1 % of the joints-held run's."""
-    theta0 = panda.spec.default_configuration
+    theta0 = boom_panda.spec.default_configuration
     runs = []
-    for law in (AccelerationLaw(panda, BOOM7_GAINS), JointServo(panda, BOOM7_GAINS, FixedReference(theta0))):
-        sim = Simulator(panda, law, force=ForcePulse(**BOOM7_KICK), q0=panda.q(theta0))
+    for law in (AccelerationLaw(boom_panda, BOOM7_GAINS), JointServo(boom_panda, BOOM7_GAINS, FixedReference(theta0))):
+        sim = Simulator(boom_panda, law, force=ForcePulse(**BOOM7_KICK), q0=boom_panda.q(theta0))
         sim.run(3.5)
         x_b = np.column_stack([sim.log.column(f"xb_{i + 1}") for i in range(6)])
         assert np.all(np.isfinite(x_b)) and np.all(np.isfinite(sim.q))

@@ -28,16 +28,13 @@ from rns_viz.scenarios import (
 )
 from rns_viz.sim import Simulator
 from rns_viz.viz.panels.control_panel import BOOM7_PRESETS, PANDA_PRESETS
+from tests.support.logs import columns
 
 pytestmark = pytest.mark.skipif(
     not robots.is_installed("example-robot-data/panda"),
     reason="example-robot-data is not installed (pip install 'rns-viz[panda]')",
 )
 RUN_S = BOOM7_START_S + BOOM7_MOVE_S + 0.1  # s: every motion is over by then
-
-
-def columns(sim: Simulator, prefix: str, k: int) -> np.ndarray:
-    return np.column_stack([sim.log.column(f"{prefix}_{i + 1}") for i in range(k)])
 
 
 def coupling_momentum(sim: Simulator) -> np.ndarray:

@@ -18,6 +18,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES
 from rns_viz.scenarios import DUAL_SCENARIOS, TREP2_CIRCLE, TREP2_GAINS, run_scenario
 from rns_viz.sim import Simulator
+from tests.support.logs import columns
 from tests.support.oracles.mujoco_replay import HeldOverEachStep, replay
 
 TASK = ["joint1", "joint2"]
@@ -26,18 +27,8 @@ M21, C21, L21, M22, C22 = 0.20, 0.08, 0.10, 0.15, 0.10  # compensator: kg, m (tr
 
 
 @pytest.fixture(scope="module")
-def trep2() -> FsmsModel:
-    return FsmsModel.from_name("trep2")
-
-
-@pytest.fixture(scope="module")
 def runs() -> dict[str, Simulator]:
     return {name: run_scenario(name) for name in DUAL_SCENARIOS}
-
-
-def columns(sim: Simulator, prefix: str, k: int) -> np.ndarray:
-    log = sim.log
-    return np.column_stack([log.column(f"{prefix}_{i + 1}") for i in range(k)])
 
 
 def ee_error(sim: Simulator) -> np.ndarray:
@@ -48,18 +39,17 @@ def ee_error(sim: Simulator) -> np.ndarray:
 
 
 # -- the model ----------------------------------------------------------------------------------
-def test_trep2_groups_its_joints_by_name_whatever_pinocchios_order(trep2: FsmsModel) -> None:
+def test_trep2_groups_its_joints_by_name_whatever_pinocchios_order(trep2: FsmsModel, trep: FsmsModel) -> None:
     assert "trep2" in BUNDLED_MODELS and "trep2" in MODEL_NAMES  # served by the live app
     assert trep2.arm_joint_names == ("c_joint1", "c_joint2", "joint1", "joint2")  # the tree's branch order
     task, comp = trep2.arm_groups["task"], trep2.arm_groups["compensating"]
     assert [trep2.arm_joint_names[i] for i in task.index] == TASK and task.frame == "ee"
     assert [trep2.arm_joint_names[i] for i in comp.index] == COMP and comp.frame == "c_ee"
-    assert FsmsModel.from_name("trep").arm_groups == {}  # single-arm models are unchanged
+    assert trep.arm_groups == {}  # single-arm models are unchanged
 
 
-def test_task_arm_is_treps_and_compensator_row_is_eq26(trep2: FsmsModel) -> None:
+def test_task_arm_is_treps_and_compensator_row_is_eq26(trep2: FsmsModel, trep: FsmsModel) -> None:
     """Same H_bm,1, J and end effector as TREP; H_b gains the compensator's 0.35 kg; h_bm,2 by Eq. (26)."""
-    trep = FsmsModel.from_name("trep")
     task, comp = trep2.arm_groups["task"].index, trep2.arm_groups["compensating"].index
     rng = np.random.default_rng(3)
     for _ in range(5):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -34,10 +36,10 @@ def random_states(model: FsmsModel, count: int, rng: np.random.Generator) -> lis
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_one_row_branches_equal_the_general_ones(name: str) -> None:
+def test_one_row_branches_equal_the_general_ones(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
     """Eq. (15) and the resolved acceleration of Fig. 1: the 1-DOF-base branches give what the
     general (any rows, numpy blocks and a solve) branches give, to rounding, singularities included."""
-    model = FsmsModel.from_name(name)
+    model = bundled_model(name)
     rng = np.random.default_rng(7)
     for q, v in random_states(model, 200, rng):
         gains = Gains(g_b=rng.uniform(0, 30), g_m=rng.uniform(0, 30))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -66,8 +67,8 @@ CASES = [("trep", "velocity"), ("trep", "acceleration"), ("trep", "torque"), ("p
 
 
 @pytest.mark.parametrize(("name", "kind"), CASES)
-def test_poles_match_the_simulators_step_map(name: str, kind: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_poles_match_the_simulators_step_map(name: str, kind: str, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     theta = model.spec.default_configuration
     loop = linearise(model, kind, theta)  # the step map of dt = 1 ms, the simulator's default
     g_b_axis, g_m_axis = default_axes(kind)
@@ -82,8 +83,10 @@ def test_poles_match_the_simulators_step_map(name: str, kind: str) -> None:
 
 @pytest.mark.parametrize(("name", "kind"), [("trep", "velocity"), ("planar3r", "acceleration"), ("trep", "torque")])
 @pytest.mark.parametrize("view", ["discrete", "continuous"])
-def test_closed_loop_is_linear_in_the_gains(name: str, kind: str, view: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_closed_loop_is_linear_in_the_gains(
+    name: str, kind: str, view: str, bundled_model: Callable[[str], FsmsModel]
+) -> None:
+    model = bundled_model(name)
     theta = model.spec.default_configuration + RNG.uniform(-0.3, 0.3, model.n)
     loop = linearise(model, kind, theta, view=view)
     for g_b, g_m in np.exp(RNG.uniform(np.log(0.1), np.log(500.0), (3, 2))):
@@ -92,13 +95,13 @@ def test_closed_loop_is_linear_in_the_gains(name: str, kind: str, view: str) -> 
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_acceleration_law_gives_the_cubic(name: str) -> None:
+def test_acceleration_law_gives_the_cubic(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
     """Law (15), 1-DOF base, continuous time. With L = h theta' (Eq. 8) the linearised law gives
     L' = h theta'' = g_b H_b x_b' - G_m L (h h^+ = 1 away from singularities) and the base row of
     Eq. (1) H_b x_b'' + L' + d x_b' + k x_b = 0; eliminating L:
         H_b s^3 + (H_b (G_m + g_b) + d) s^2 + (k + d G_m) s + k G_m = 0.
     The other poles: the arm's motion in the RNS, u = -G_m theta', at -G_m (n - 1 of them)."""
-    model = FsmsModel.from_name(name)
+    model = bundled_model(name)
     theta = model.spec.default_configuration
     H_b = model.mass_matrix(model.q(theta))[0, 0]
     k, d = model.K_b[0, 0], model.D_b[0, 0]
@@ -145,8 +148,8 @@ SUBSETS = {
     ("name", "kind"),
     [("trep", "velocity"), pytest.param("planar3r", "acceleration", marks=pytest.mark.slow)],  # 9 x 7 s simulated
 )
-def test_predicted_base_decay_matches_a_kick(name: str, kind: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_predicted_base_decay_matches_a_kick(name: str, kind: str, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     rows, cols, duration, peak, start = SUBSETS[(name, kind)]
     grid = gain_map(model, kind)
     errors = []
@@ -175,8 +178,8 @@ def _released(model: FsmsModel, g_b: float, g_m: float, duration: float) -> Simu
     return sim
 
 
-def test_points_marked_unstable_diverge() -> None:
-    model = FsmsModel.from_name("trep")
+def test_points_marked_unstable_diverge(trep: FsmsModel) -> None:
+    model = trep
     grid = gain_map(model, "velocity")
     # g_b = 2500 /s, g_m = 8 /s: the base mode grows (g_b H_b times the 1 ms hold is too much).
     i, j = 58, 25
@@ -246,7 +249,7 @@ def _cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "rns_viz.cli", *args], capture_output=True, text=True, timeout=120)
 
 
-def test_cli_gains_writes_the_map(tmp_path: Path) -> None:
+def test_cli_gains_writes_the_map(tmp_path: Path, trep: FsmsModel) -> None:
     out = tmp_path / "map.csv"
     result = _cli("gains", "--model", "trep", "--law", "30", "--csv", str(out))
     assert result.returncode == 0, result.stderr
@@ -259,7 +262,7 @@ def test_cli_gains_writes_the_map(tmp_path: Path) -> None:
     assert np.all(data[stable, 2] > 0)
     # the same numbers as the library
     paper = np.argmin(np.abs(np.log(data[:, 0] / 24.0)) + np.abs(np.log(data[:, 1] / 20.0)))
-    loop = linearise(FsmsModel.from_name("trep"), "velocity")
+    loop = linearise(trep, "velocity")
     expected = float(modes_of(loop, data[paper, 0], data[paper, 1]).base_decay_rate)
     assert data[paper, 2] == pytest.approx(expected, rel=1e-5)
 

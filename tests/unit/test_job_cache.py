@@ -34,9 +34,9 @@ def replies(stream: io.BytesIO) -> list[bytes]:
 
 
 def test_a_repeated_request_is_computed_once_and_answered_with_the_same_bytes(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, trep: FsmsModel
 ) -> None:
-    seed = FsmsModel.from_key("trep").spec.default_configuration
+    seed = trep.spec.default_configuration
     computed: list[str] = []
 
     def counting(name: str, real: Any) -> Any:

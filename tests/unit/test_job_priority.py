@@ -28,8 +28,7 @@ def test_selection_key_names_forces_only() -> None:
     assert model_key("boom7", (1, 1, 1, 0, 0, 0)) == FORCES_ONLY_KEY
 
 
-def test_a_reach_request_overtakes_the_gain_explorers_sweep(monkeypatch: pytest.MonkeyPatch) -> None:
-    boom7 = FsmsModel.from_name("boom7")
+def test_a_reach_request_overtakes_the_gain_explorers_sweep(monkeypatch: pytest.MonkeyPatch, boom7: FsmsModel) -> None:
     theta0 = boom7.spec.default_configuration
     thetas = theta0 + np.outer(np.linspace(0.0, 0.4, SWEEP), np.ones(boom7.n))  # rad, inside the limits
     assert np.all(thetas < boom7.upper) and np.all(thetas > boom7.lower)

@@ -11,8 +11,8 @@ from rns_viz.viz.panels.base_panel import kick_weights
 
 
 @pytest.fixture(scope="module")
-def turns() -> tuple[bool, ...]:
-    return FsmsModel.from_key("boom7").base_rotational
+def turns(boom7: FsmsModel) -> tuple[bool, ...]:
+    return boom7.base_rotational
 
 
 def test_the_weights_are_the_force_on_translations_and_its_moment_on_rotations(turns: tuple[bool, ...]) -> None:

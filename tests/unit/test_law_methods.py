@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -51,10 +52,12 @@ def test_kinds(trep: FsmsModel) -> None:
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_retune_of_g_m_changes_theta_ddot_by_minus_delta_g_m_theta_dot(name: str) -> None:
+def test_retune_of_g_m_changes_theta_ddot_by_minus_delta_g_m_theta_dot(
+    name: str, bundled_model: Callable[[str], FsmsModel]
+) -> None:
     """Eq. (15) with the default null input: -G_m (E - P) theta' - G_m P theta' = -G_m theta', so
     retuning g_m alone changes theta'' by -(g_m' - g_m) theta', and tau by that through Fig. 1."""
-    model = FsmsModel.from_name(name)
+    model = bundled_model(name)
     q, v = state(model)
     law = AccelerationLaw(model, Gains(g_b=5.0, g_m=1.0))
     before = law(0.0, q, v).tau

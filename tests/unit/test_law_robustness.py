@@ -9,6 +9,8 @@ the output is finite and is what the physics says it is, checked against pinocch
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -75,8 +77,8 @@ def assert_close(residual: np.ndarray, *terms: np.ndarray | float, what: str) ->
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_every_law_stays_finite_and_physical(name: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_every_law_stays_finite_and_physical(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     plant = Plant(model)
     evaluator = CouplingEvaluator(model)
     inverse_bound = 1.0 / evaluator.threshold

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -31,8 +33,8 @@ def test_planar3r_hbm_matches_closed_form(planar3r: FsmsModel) -> None:
 
 
 @pytest.mark.parametrize(("name", "total"), [("trep", 0.795 + 0.310 + 0.120), ("planar3r", 1.0 + 30.0)])
-def test_base_inertia_is_base_plus_arm_mass(name: str, total: float) -> None:
-    model = FsmsModel.from_name(name)
+def test_base_inertia_is_base_plus_arm_mass(name: str, total: float, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     for _ in range(20):
         q, v = random_state(model)
         np.testing.assert_allclose(model.terms(q, v).H_b, [[total]], rtol=1e-14)
@@ -40,9 +42,9 @@ def test_base_inertia_is_base_plus_arm_mass(name: str, total: float) -> None:
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_velocity_terms_match_finite_differences(name: str) -> None:
+def test_velocity_terms_match_finite_differences(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
     """H_bm' theta' and J' theta' by central differences along the motion; c_b = H_bm' theta'."""
-    model = FsmsModel.from_name(name)
+    model = bundled_model(name)
     eps = 1e-6
     for _ in range(20):
         q, v = random_state(model)

@@ -54,9 +54,9 @@ def test_a_module_that_fails_to_import_is_refused(monkeypatch: pytest.MonkeyPatc
 
 
 def test_an_unusable_module_warns_once_and_the_python_step_runs(
-    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, trep: FsmsModel
 ) -> None:
-    model = FsmsModel.from_name("trep")
+    model = trep
     law = AccelerationLaw(model, Gains(g_b=20.0, g_m=5.0))
     kick = ForcePulse(0.01, 0.05, (2.0,))
     reference = Simulator(model, law, force=kick, native=False)

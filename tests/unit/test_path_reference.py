@@ -4,6 +4,8 @@ time derivative of its velocity, and the same whatever the order of the queries.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -27,8 +29,10 @@ def coupling(model: FsmsModel, theta: np.ndarray) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", ["trep", "boom7"])
-def test_the_reference_is_reactionless_and_matches_an_independent_integration(name: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_the_reference_is_reactionless_and_matches_an_independent_integration(
+    name: str, bundled_model: Callable[[str], FsmsModel]
+) -> None:
+    model = bundled_model(name)
     theta0 = np.linspace(0.3, 0.9, model.n)
     ref = PathReference(model, theta0, ubar)
     times = np.linspace(0.0, 0.6, 41)[1:]
@@ -57,8 +61,8 @@ def test_the_reference_is_reactionless_and_matches_an_independent_integration(na
     assert np.allclose(ref(t)[2], (after - before) / (2 * h), rtol=1e-5, atol=1e-9)
 
 
-def test_queries_in_any_order_give_the_path_through_the_same_points() -> None:
-    model = FsmsModel.from_name("trep")
+def test_queries_in_any_order_give_the_path_through_the_same_points(trep: FsmsModel) -> None:
+    model = trep
     theta0 = np.array([0.5, 1.2])
     ref = PathReference(model, theta0, ubar)
     for t in (0.0103, 0.0105, 0.2, 0.05, 0.0, 0.31, 0.31, 0.3107):  # partial steps, repeats and restarts

@@ -8,6 +8,7 @@ link lies along the x axis, i.e. where every absolute angle is 0 or pi.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -21,8 +22,10 @@ def absolute_angles(theta: np.ndarray) -> np.ndarray:
 
 
 @pytest.mark.parametrize(("name", "points"), [("trep", 12), ("planar3r", 6)])
-def test_rank_deficient_points_are_the_links_along_the_deflection_axis(name: str, points: int) -> None:
-    model = FsmsModel.from_name(name)
+def test_rank_deficient_points_are_the_links_along_the_deflection_axis(
+    name: str, points: int, bundled_model: Callable[[str], FsmsModel]
+) -> None:
+    model = bundled_model(name)
     loss = rank_deficient_configurations(model, points_per_joint=points)
     n = model.n
     expected = {tuple(c) for c in itertools.product((0, 1), repeat=n)}  # absolute angle 0 or pi per link
@@ -33,9 +36,11 @@ def test_rank_deficient_points_are_the_links_along_the_deflection_axis(name: str
 
 
 @pytest.mark.parametrize(("name", "points"), [("trep", 12), ("planar3r", 6)])
-def test_every_drawn_point_is_rank_deficient_and_reactionless_along_the_kernel(name: str, points: int) -> None:
+def test_every_drawn_point_is_rank_deficient_and_reactionless_along_the_kernel(
+    name: str, points: int, bundled_model: Callable[[str], FsmsModel]
+) -> None:
     """sigma_min(S H_bm) <= 1e-9 |H_bm| at every point; a kernel velocity couples <= 1e-9 of the most coupled one."""
-    model = FsmsModel.from_name(name)
+    model = bundled_model(name)
     loss = rank_deficient_configurations(model, points_per_joint=points)
     assert loss.scale > 0.01  # kg m: the grid's most coupled direction is a real coupling
     for theta, sigma, ee in zip(loss.theta, loss.sigma_min, loss.ee, strict=True):
@@ -48,10 +53,10 @@ def test_every_drawn_point_is_rank_deficient_and_reactionless_along_the_kernel(n
         assert abs(ee[1]) <= 1e-9  # every link along x: the end effector is on the deflection axis
 
 
-def test_next_to_rank_loss_the_same_velocity_does_couple() -> None:
+def test_next_to_rank_loss_the_same_velocity_does_couple(trep: FsmsModel) -> None:
     """Reactionless only at the points: 0.1 rad away along joint 1, turning joint 1 couples in first order
     (|dh_1/dtheta_1| = |A cos + B cos| >= A - B = 0.031 kg m at every point, so >= 0.0031 kg m there)."""
-    model = FsmsModel.from_name("trep")
+    model = trep
     loss = rank_deficient_configurations(model)
     turn_joint_1 = np.array([1.0, 0.0])  # rad/s
     for theta in loss.theta:
@@ -60,9 +65,9 @@ def test_next_to_rank_loss_the_same_velocity_does_couple() -> None:
         assert abs(at[0]) <= 1e-9 * loss.scale and abs(near[0]) >= 0.2 * 0.1 * loss.scale  # kg m/s
 
 
-def test_compensator_alone_loses_rank_along_the_beam_axis() -> None:
+def test_compensator_alone_loses_rank_along_the_beam_axis(trep2: FsmsModel) -> None:
     """trep2's compensating arm: its own S H_bm,2 vanishes with both links along x, at any task-arm pose."""
-    model = FsmsModel.from_name("trep2")
+    model = trep2
     comp = model.arm_groups["compensating"].index
     loss = rank_deficient_configurations(model, columns=comp, points_per_joint=8)
     assert len(loss.theta) == 4
@@ -71,8 +76,8 @@ def test_compensator_alone_loses_rank_along_the_beam_axis() -> None:
         assert np.allclose(theta[model.arm_groups["task"].index], model.spec.default_configuration[2:])
 
 
-def test_sigma_grid_has_its_zeros_at_the_rank_deficient_points() -> None:
-    model = FsmsModel.from_name("trep")
+def test_sigma_grid_has_its_zeros_at_the_rank_deficient_points(trep: FsmsModel) -> None:
+    model = trep
     a, b, field = sigma_grid(model, [0, 1], points_per_joint=9)  # nodes at multiples of pi/4
     zeros = {(round(a[i] / np.pi, 6), round(b[j] / np.pi, 6)) for i, j in zip(*np.nonzero(field < 1e-12), strict=True)}
     assert zeros == {(x, y) for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)}

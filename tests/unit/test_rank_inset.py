@@ -8,6 +8,8 @@ pixels). In the app: tests/app/test_rank_inset.py.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -24,8 +26,10 @@ def _sigma_min(model: FsmsModel, theta: np.ndarray) -> float:
 
 
 @pytest.mark.parametrize(("name", "theta", "filled"), PLANES)
-def test_every_drawn_marker_has_lost_rank_and_the_field_is_sigma_min(name: str, theta: np.ndarray, filled: int) -> None:
-    model = FsmsModel.from_name(name)
+def test_every_drawn_marker_has_lost_rank_and_the_field_is_sigma_min(
+    name: str, theta: np.ndarray, filled: int, bundled_model: Callable[[str], FsmsModel]
+) -> None:
+    model = bundled_model(name)
     data = rank_inset(name, inset_slice(name, theta))
     assert data is not None and data.scale > 0.0
     assert int(data.in_plane.sum()) == filled  # TREP: all 4; the 3R at theta_1 = 0: 4 of its 8

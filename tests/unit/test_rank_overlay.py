@@ -8,6 +8,8 @@ x), so every drawn point lies on y = 0; and there a joint velocity along the ker
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -17,8 +19,8 @@ from rns_viz.rank import kernel_coupling
 
 
 @pytest.mark.parametrize(("name", "count"), [("trep", 4), ("planar3r", 8)])
-def test_every_drawn_pose_has_lost_rank(name: str, count: int) -> None:
-    model = FsmsModel.from_name(name)
+def test_every_drawn_pose_has_lost_rank(name: str, count: int, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     overlay = rank_overlay(name)
     assert overlay is not None
     assert len(overlay.poses) == count  # links folded or stretched along x: 2^n poses

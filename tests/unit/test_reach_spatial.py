@@ -16,8 +16,8 @@ from rns_viz.model import FsmsModel
 
 
 @pytest.fixture(scope="module")
-def forces_only() -> FsmsModel:
-    return FsmsModel.from_name("boom7").with_selection([1, 1, 1, 0, 0, 0])
+def forces_only(boom7: FsmsModel) -> FsmsModel:
+    return boom7.with_selection([1, 1, 1, 0, 0, 0])
 
 
 def test_forces_only_reactionless_motion_keeps_the_centre_of_mass(forces_only: FsmsModel) -> None:
@@ -39,7 +39,7 @@ def _rank(coupling: Callable[[np.ndarray], np.ndarray]) -> int:
     return bracket_rank(coupling, np.array([0.3, -0.2, 0.5])).with_brackets
 
 
-def test_bracket_rank_against_closed_forms(forces_only: FsmsModel) -> None:
+def test_bracket_rank_against_closed_forms(forces_only: FsmsModel, boom7: FsmsModel) -> None:
     # Heisenberg constraint dz - (x dy - y dx)/2 = 0 in R^3: [X, Y] = (0, 0, -1) leaves the plane: rank 3.
     assert _rank(lambda th: np.array([[th[1] / 2, -th[0] / 2, 1.0]])) == 3
     # dz = 0 (an integrable constraint, rows = a gradient): the brackets stay in it, rank 2.
@@ -52,7 +52,7 @@ def test_bracket_rank_against_closed_forms(forces_only: FsmsModel) -> None:
     moments = m.with_selection([0, 0, 0, 1, 1, 1])  # angular momentum is not a gradient
     turning = bracket_rank(lambda th: moments.coupling_matrix(moments.q(th)), theta0)
     assert not turning.involutive and turning.with_brackets > 4 and "not involutive" in turning.words()
-    one = FsmsModel.from_name("boom7")  # S = E: a 1-D distribution is always involutive
+    one = boom7  # S = E: a 1-D distribution is always involutive
     assert bracket_rank(lambda th: one.coupling_matrix(one.q(th)), theta0).with_brackets == 1
 
 

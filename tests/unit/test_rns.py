@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -20,8 +22,8 @@ RNG = np.random.default_rng(3)
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_projector_is_orthogonal_and_annihilates_hbm(name: str) -> None:
-    model = FsmsModel.from_name(name)
+def test_projector_is_orthogonal_and_annihilates_hbm(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
+    model = bundled_model(name)
     for _ in range(100):
         theta = RNG.uniform(-np.pi, np.pi, model.n)
         H = model.coupling_matrix(model.q(theta))
@@ -166,10 +168,10 @@ def test_one_row_inverse_does_not_depend_on_the_matrix_after_the_call() -> None:
     assert matrix is inverse.inverse and sigma == pytest.approx(np.sqrt(0.09 + 0.16 + 1.44)) and damping == 0.0
 
 
-def test_multi_row_damped_inverse_equals_its_formula() -> None:
+def test_multi_row_damped_inverse_equals_its_formula(boom7: FsmsModel) -> None:
     """The multi-row damped inverse of Eq. (15), A^T (A A^T + lambda^2 E)^-1, on boom7's six coupling
     rows (the shared identity E must not leak between calls)."""
-    model = FsmsModel.from_name("boom7")
+    model = boom7
     m = model.m
     for _ in range(20):
         q = model.q(RNG.uniform(-np.pi, np.pi, model.n))

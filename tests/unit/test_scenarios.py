@@ -78,7 +78,7 @@ def test_fig10_suppression(runs: Runs) -> None:
             assert min(envelope(t, xb, k, k + 1.0) for k in range(1, 9)) > 0.5 * peak
 
 
-def test_fig12_reactionless_cycling_does_not_disturb_vibration(runs: Runs) -> None:
+def test_fig12_reactionless_cycling_does_not_disturb_vibration(runs: Runs, trep: FsmsModel) -> None:
     on, off = runs("fig12-on").log, runs("fig12-off").log
     t = on.column("t")
     kick = 4.0
@@ -89,7 +89,7 @@ def test_fig12_reactionless_cycling_does_not_disturb_vibration(runs: Runs) -> No
     xb_on = on.column("xb_1")
     assert envelope(t, xb_on, 11.0, 12.0) < 0.6 * envelope(t, xb_on, kick, kick + 1.0)
     # Without it, the envelope is that of the same kick on a motionless arm (within 10 %).
-    model = FsmsModel.from_name("trep")
+    model = trep
     theta0 = np.deg2rad([90.0, 0.0])
     still = Simulator(
         model,

@@ -21,14 +21,9 @@ from rns_viz.scenarios import FORCES_ONLY, boom7_track, boom7_track_end
 SELECTIONS = [FORCES_ONLY, (0, 0, 0, 1, 1, 1), (0, 1, 0, 0, 0, 0), (0, 1, 1, 0, 0, 0), (1, 1, 1, 1, 1, 1)]
 
 
-@pytest.fixture(scope="module")
-def boom() -> FsmsModel:
-    return FsmsModel.from_name("boom7")
-
-
-def test_the_suppression_term_makes_the_selected_rows_of_eq_13_hold(boom: FsmsModel) -> None:
+def test_the_suppression_term_makes_the_selected_rows_of_eq_13_hold(boom7: FsmsModel) -> None:
     """S H_bm theta''_supp = g_b S H_b x_b' with every base velocity, including the free ones."""
-    model = boom.with_selection(FORCES_ONLY)
+    model = boom7.with_selection(FORCES_ONLY)
     rng = np.random.default_rng(7)
     theta = np.array(model.spec.default_configuration) + rng.uniform(-0.1, 0.1, model.n)
     q = model.q(theta)
@@ -45,10 +40,10 @@ def test_the_suppression_term_makes_the_selected_rows_of_eq_13_hold(boom: FsmsMo
 
 
 @pytest.mark.parametrize("selection", SELECTIONS)
-def test_linearised_loop_is_stable_over_the_gain_map(boom: FsmsModel, selection: tuple[int, ...]) -> None:
+def test_linearised_loop_is_stable_over_the_gain_map(boom7: FsmsModel, selection: tuple[int, ...]) -> None:
     """Every pole of (15) + plant (1 ms step map, torque held) has a negative real part, g_b 0.1-1000 /s,
     g_m 0.1-100 /s, at the default configuration and where forces-only tracking ends."""
-    model = boom.with_selection(selection)
+    model = boom7.with_selection(selection)
     g_b, g_m = np.meshgrid(np.logspace(-1, 3, 13), np.logspace(-1, 2, 7))
     for theta in (None, np.array(boom7_track_end())):
         loop = linearise(model, "15", theta)
@@ -57,10 +52,10 @@ def test_linearised_loop_is_stable_over_the_gain_map(boom: FsmsModel, selection:
 
 
 @pytest.mark.parametrize("law", ["16", "30"])
-def test_the_other_suppression_laws_are_stable_with_forces_only(boom: FsmsModel, law: str) -> None:
+def test_the_other_suppression_laws_are_stable_with_forces_only(boom7: FsmsModel, law: str) -> None:
     """(16) and (30) take S H_b G_b x_b' and S H_b g_b x_b the same way; with the selected block they were
     unstable from g_b = 10 /s (g_m = 2 /s) on boom7 with forces only."""
-    model = boom.with_selection(FORCES_ONLY)
+    model = boom7.with_selection(FORCES_ONLY)
     g_b, g_m = np.meshgrid(np.logspace(-1, 2, 10), np.logspace(0, 2, 5))
     slowest = linearise(model, law).poles(g_b, g_m).real.max(axis=-1)  # 1/s
     assert slowest.max() < -0.01, slowest.max()

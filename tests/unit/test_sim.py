@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -48,8 +49,10 @@ def cubic_response(H_b: float, k: float, d: float, g_b: float, G_m: float, x0: f
 @pytest.mark.parametrize(
     ("name", "g_b", "G_m", "x0"), [("trep", 24.0, 20.0, 2e-3), ("trep", 10.0, 2.0, 1e-3), ("planar3r", 10.0, 1.0, 1e-2)]
 )
-def test_acceleration_law_matches_closed_loop_cubic(name: str, g_b: float, G_m: float, x0: float) -> None:
-    model = FsmsModel.from_name(name)
+def test_acceleration_law_matches_closed_loop_cubic(
+    name: str, g_b: float, G_m: float, x0: float, bundled_model: Callable[[str], FsmsModel]
+) -> None:
+    model = bundled_model(name)
     law = AccelerationLaw(model, Gains(g_b=g_b, g_m=G_m))
     q0 = model.q(model.spec.default_configuration, [x0])
     sim = Simulator(model, law, hold_control=False, q0=q0, log_capacity=5001)
@@ -71,9 +74,9 @@ def test_cubic_oracle_is_not_trivial() -> None:
 
 
 @pytest.mark.parametrize("name", ["trep", "planar3r"])
-def test_passive_system_conserves_energy_and_momentum(name: str) -> None:
+def test_passive_system_conserves_energy_and_momentum(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
     """Zero torque, no damping: energy constant; total momentum changes only by the spring impulse."""
-    spec = FsmsModel.from_name(name).spec
+    spec = bundled_model(name).spec
     model = FsmsModel(replace(spec, base=replace(spec.base, damping=np.zeros((1, 1)))))  # no base damper
     rng = np.random.default_rng(1)
     q0 = model.q(model.spec.default_configuration, [0.01])
@@ -85,9 +88,9 @@ def test_passive_system_conserves_energy_and_momentum(name: str) -> None:
 
 
 @pytest.mark.parametrize("law_cls", [AccelerationLaw, TorqueLaw])
-def test_composite_laws_damp_a_kick(law_cls: type) -> None:
+def test_composite_laws_damp_a_kick(law_cls: type, trep: FsmsModel) -> None:
     """With suppression the kick dies out; with the joints held, TREP (no base damping) keeps vibrating."""
-    model = FsmsModel.from_name("trep")
+    model = trep
 
     def peak_after(suppress: bool) -> float:
         gains = Gains(g_b=24.0, g_m=5.0)
@@ -102,9 +105,9 @@ def test_composite_laws_damp_a_kick(law_cls: type) -> None:
     assert peak_after(False) > 0.9
 
 
-def test_torque_law_sign_convention() -> None:
+def test_torque_law_sign_convention(trep: FsmsModel) -> None:
     """A negative gain must excite: the sign of G_b in (16) is the damping one."""
-    model = FsmsModel.from_name("trep")
+    model = trep
     law = TorqueLaw(model, Gains(g_b=2.0, g_m=0.0))
     law.gains = Gains.__new__(Gains)  # bypass validation to test the sign: g_b = -2
     object.__setattr__(law.gains, "g_b", -2.0)
@@ -114,9 +117,9 @@ def test_torque_law_sign_convention() -> None:
     assert np.abs(sim.log.column("xb_1")).max() > 2e-3
 
 
-def test_reactionless_motion_does_not_move_the_base() -> None:
+def test_reactionless_motion_does_not_move_the_base(trep: FsmsModel) -> None:
     """Joint velocity along n from a resting base: the coupling momentum stays zero, so does x_b."""
-    model = FsmsModel.from_name("trep")
+    model = trep
     theta0 = np.array([1.0, 1.0])
     h = model.coupling_matrix(model.q(theta0))[0]
     n = np.array([h[1], -h[0]])
@@ -130,8 +133,8 @@ def test_reactionless_motion_does_not_move_the_base() -> None:
     assert np.ptp(sim.log.column("theta_2")) > 0.5
 
 
-def test_velocity_law_damps_and_holds() -> None:
-    model = FsmsModel.from_name("trep")
+def test_velocity_law_damps_and_holds(trep: FsmsModel) -> None:
+    model = trep
     theta0 = model.spec.default_configuration
     sim = Simulator(
         model, VelocityLaw(model, Gains(g_b=24.0, g_m=20.0), FixedReference(theta0)), q0=model.q(theta0, [5e-3])
@@ -141,8 +144,8 @@ def test_velocity_law_damps_and_holds() -> None:
     np.testing.assert_allclose(sim.q[1:], theta0, atol=0.05)
 
 
-def test_joint_servo_holds_against_a_kick() -> None:
-    model = FsmsModel.from_name("planar3r")
+def test_joint_servo_holds_against_a_kick(planar3r: FsmsModel) -> None:
+    model = planar3r
     theta0 = model.spec.default_configuration
     sim = Simulator(model, JointServo(model, Gains(), FixedReference(theta0)), force=ForcePulse(0.1, 0.2, (5.0,)))
     sim.run(3.0)
@@ -150,8 +153,8 @@ def test_joint_servo_holds_against_a_kick() -> None:
     np.testing.assert_allclose(sim.q[1:], theta0, atol=1e-3)
 
 
-def test_simulation_is_deterministic() -> None:
-    model = FsmsModel.from_name("trep")
+def test_simulation_is_deterministic(trep: FsmsModel) -> None:
+    model = trep
 
     def run() -> np.ndarray:
         law = AccelerationLaw(model, Gains(g_b=24.0, g_m=20.0))
@@ -162,9 +165,9 @@ def test_simulation_is_deterministic() -> None:
     np.testing.assert_array_equal(run(), run())
 
 
-def test_no_nan_at_the_trep_singularity() -> None:
+def test_no_nan_at_the_trep_singularity(trep: FsmsModel) -> None:
     """Start on H_bm = 0 (arm along x) with a deflection: the damped inverse keeps numbers finite."""
-    model = FsmsModel.from_name("trep")
+    model = trep
     for theta in ([0.0, 0.0], [0.0, np.pi], [np.pi, 0.0]):
         for law in (
             AccelerationLaw(model, Gains(g_b=24.0, g_m=2.0)),
@@ -177,8 +180,8 @@ def test_no_nan_at_the_trep_singularity() -> None:
             assert np.all(np.isfinite([sim.log.column(c) for c in state]))
 
 
-def test_divergence_is_reported_not_hidden() -> None:
-    model = FsmsModel.from_name("trep")
+def test_divergence_is_reported_not_hidden(trep: FsmsModel) -> None:
+    model = trep
 
     class Wild:
         def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput:
@@ -197,9 +200,9 @@ def test_gains_refuse_bad_values(bad: object) -> None:
         Gains(g_b=bad)  # type: ignore[arg-type]
 
 
-def test_cheap_integrator_is_close_to_rk4() -> None:
+def test_cheap_integrator_is_close_to_rk4(trep: FsmsModel) -> None:
     """The semi-implicit Euler option tracks the RK4 reference to within a few per cent at 1 ms."""
-    model = FsmsModel.from_name("trep")
+    model = trep
     theta0 = model.spec.default_configuration
 
     def run(integrator: str) -> np.ndarray:

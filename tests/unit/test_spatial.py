@@ -36,20 +36,12 @@ from rns_viz.scenarios import (
 )
 from rns_viz.sim import Simulator
 from rns_viz.sim.plant import Plant
+from tests.support.logs import columns
 from tests.support.oracles.mujoco_replay import HeldOverEachStep, replay
 
 RUN_S = BOOM7_START_S + BOOM7_MOVE_S + 0.1  # s: every motion is over by then
 # The boom of boom7.toml: aluminium tube, E, G in Pa, length, outer diameter and wall in m.
 E, G, L, D_OUT, WALL = 68.9e9, 26.0e9, 4.0, 0.100, 0.002
-
-
-@pytest.fixture(scope="module")
-def boom7() -> FsmsModel:
-    return FsmsModel.from_name("boom7")
-
-
-def columns(sim: Simulator, prefix: str, k: int) -> np.ndarray:
-    return np.column_stack([sim.log.column(f"{prefix}_{i + 1}") for i in range(k)])
 
 
 def energy_norm_peak(sim: Simulator) -> float:
@@ -237,9 +229,8 @@ def test_spatial_presets_are_apart_from_the_apps(boom7: FsmsModel) -> None:
     assert (gains.g_b, gains.g_m) == (BOOM7_GAINS.g_b, BOOM7_GAINS.g_m)
 
 
-def test_damping_threshold_follows_sigma_min(boom7: FsmsModel) -> None:
+def test_damping_threshold_follows_sigma_min(boom7: FsmsModel, trep: FsmsModel) -> None:
     """10 % of sigma_min(S H_bm(theta_0)): for one row that is |h| (TREP as before); boom7 is not damped."""
-    trep = FsmsModel.from_name("trep")
     h = trep.coupling_matrix(trep.q(trep.spec.default_configuration))
     assert CouplingEvaluator(trep).threshold == pytest.approx(0.1 * np.linalg.norm(h), rel=1e-12)
     H = boom7.coupling_matrix(boom7.q(boom7.spec.default_configuration))
