@@ -99,7 +99,7 @@ requires_chromium = pytest.mark.skipif(
 # browser, a server running in real time) goes to one worker, one test at a time, so two of them never
 # share the two cores; the headless tests fill the other worker.
 live_group = pytest.mark.xdist_group("live")
-# What every real-browser test module starts with: ``pytestmark = browser_marks`` (or ``[*browser_marks, ...]``).
+# What every real-browser test gets, applied by tests/conftest.py to the tests in tests/browser/.
 browser_marks = [pytest.mark.browser, requires_chromium, live_group]
 
 
