@@ -31,6 +31,7 @@ from rns_viz.live.runs import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.settle import settled_elsewhere
 from rns_viz.live.snapshot import make_snapshot
 from rns_viz.model import FsmsModel
+from rns_viz.params import model_source
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
@@ -82,6 +83,7 @@ class LiveState:
         self.settings = replace(self.settings, preset=None)
         self._restart_bookkeeping()
         op = self.operator
+        self._explore(theta0)  # before any geometry is taken: the explorer is on this model from here on
         table = self.geometry.default_tables.get(name) if theta is None else None
         if table is not None and op is not None and op.accept_table(table, self.tol):
             self._took_table(table, default=True)
@@ -100,7 +102,11 @@ class LiveState:
         self.runs.install(self._choice(), op.joint, op.law_task(self.settings.law), op.joint_move is not None)
 
     def _restart_bookkeeping(self) -> None:
+        """A new epoch: the run restarted (reset, model switch, preset, selection). A lesson goes on only on
+        its own model (a preset or selection of it); what the old epoch published is cleared."""
         self.epoch += 1
+        if self.lesson is not None and model_source(self.model.name) != self.lesson.model:
+            self.lesson = None
         self.settings_version += 1
         self.target_version += 1
         self.paused, self.diverged = False, None
@@ -149,11 +155,11 @@ class LiveState:
         self._explore(theta)
 
     def _explore(self, theta: np.ndarray) -> None:
-        self.explorer.context(self.model.name, self.settings.law, theta, self.settings.gains)
+        self.explorer.context(self.epoch, self.model.name, self.settings.law, theta, self.settings.gains)
 
     def _took_table(self, table: PathTable, default: bool) -> None:
         self.geometry.took_table(self.model.name, table, default)
-        self.explorer.along(table.theta, table.ee)
+        self.explorer.along(self.model.name, table.theta, table.ee)
 
     def notify(self, title: str, body: str, client: int | None = None, level: Level = "info") -> None:
         self.notices.append(Notice(title, body, client, level))
@@ -204,12 +210,13 @@ class LiveState:
                 duration = defaults_for(st.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m, direction))
                 self.kicks_sent += 1
-                self.explorer.kicked(self.runs.t)
+                self.explorer.kicked(self.runs.t, st.suppress)
             case c.SetSuppression(on=on):
                 self.runs.set_suppression(on)
                 if on != st.suppress:  # the runs swap roles: both, and the plots, restart from here
                     self.runs.resync_shadow()
                     self.outputs.plots.clear()
+                    self.explorer.forget_measurement()
                 self.settings = replace(st, suppress=on)
             case c.SetLaw(law=law):
                 refuse_other_laws(self.model, law)
@@ -383,13 +390,13 @@ class LiveState:
                     if self.operator is not None and not self.operator.on_path:
                         self.operator.reach = region
                     self.geometry.took_reach(region)
-                    self.explorer.along(region.thetas, region.points)
+                    self.explorer.along(self.model.name, region.thetas, region.points)
                     self._overlays_changed()
         self.explorer.collect()
 
     # ================================================================ outputs
     def _overlays_changed(self) -> None:
-        self.overlays = self.geometry.overlays(self.model.name)
+        self.overlays = self.geometry.overlays(self.model.name, self.epoch)
 
     def publish(self, realtime: bool) -> Snapshot:
         versions = (self.epoch, self.settings_version, self.target_version, self.geometry.version)
