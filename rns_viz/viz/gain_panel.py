@@ -23,6 +23,7 @@ from rns_viz.viz.connections import Connections
 from rns_viz.viz.gain_scene import LN10, GainScene, Quantity
 from rns_viz.viz.gui import GAIN_SLIDERS, GuiElements
 from rns_viz.viz.inputs import Controls
+from rns_viz.viz.model_menu import label_of
 from rns_viz.viz.style import SceneStyle
 
 QUANTITIES: dict[str, Quantity] = {
@@ -114,6 +115,7 @@ class GainExplorerView:
         self.clicks_applied = 0
         self._next_check = 0.0
         self._drawn: dict[str, object] = {}
+        self._loci_of: tuple[str, str] | None = None  # (model, law) of the root loci drawn
         self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:
@@ -124,14 +126,16 @@ class GainExplorerView:
         self._drawn = {}
 
     # -- per frame -------------------------------------------------------------------------------
-    def frame(self) -> None:
+    def frame(self, model: str) -> None:
+        """Draw the session's gain view if it changed and is of ``model``, the model whose scene is built
+        (a view of the next model waits for its scene)."""
         now = time.perf_counter()
         if now < self._next_check:
             return
         self._next_check = now + CHECK_S
         view = self.session.gain_view()
         quantity = QUANTITIES.get(self.controls.good(self.quantity), "base")
-        if self.scene is None or (view.version == self._version and quantity == self._quantity):
+        if self.scene is None or view.model != model or (view.version == self._version and quantity == self._quantity):
             return
         map_changed = view.map is not self.scene.gain_map or quantity != self._quantity
         self._version, self._quantity = view.version, quantity
@@ -167,7 +171,16 @@ class GainExplorerView:
                 handle.content = text
 
     def _show_loci(self, view: GainView) -> None:
+        """The root loci of the view. While new ones are computed the plots keep the last ones of this model
+        and law (their titles name the gains they are at); another model's or law's are cleared."""
         reach = _reach(view)
+        if (view.model, view.law) != self._loci_of:
+            self._loci_of = (view.model, view.law)
+            for plot in (self.locus_b, self.locus_m):
+                plot.data = tuple(np.zeros(2) for _ in range(4))
+                plot.title = (
+                    "Root locus: being computed…" if view.analysed else "Root locus: not computed for this model"
+                )
         for plot, locus, other in ((self.locus_b, view.locus_g_b, "g_m"), (self.locus_m, view.locus_g_m, "g_b")):
             if locus is None:
                 continue
@@ -242,19 +255,26 @@ def _fmt_rate(rate: float) -> str:
 
 
 def predicted_text(view: GainView) -> str:
-    """One line: predicted base decay at the gains in force, and after a kick the measured one."""
+    """One line: predicted base decay at the gains in force, and after a kick the measured one, naming what
+    it measured (model, gains, kick); only a measurement of the view's model, law, gains and run is shown."""
     gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
-    pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+    if view.analysed:
+        pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+    else:
+        pred = f"**Base decay** at {gains}: not predicted for this model (no linearisation of its compensating law)"
     m = view.measured
-    if m is None:
-        return f"{pred}; *kick the base to measure it* (fit of the |x_b| peaks, 4–20 s after the kick)."
+    if m is None or (m.model, m.law, m.gains, m.epoch) != (view.model, view.law, view.gains, view.epoch):
+        return f"{pred}; *kick the base with suppression on to measure it* (fit of the |x_b| peaks, 4–20 s after)."
+    what = f"{label_of(m.model)}, g_b = {m.gains.g_b:.4g}, g_m = {m.gains.g_m:.4g} 1/s"
     fit = f"fit over {m.seconds:.1f} s after the kick at t = {m.since:.1f} s"
-    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({fit})."
+    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({what}, {fit})."
 
 
 def authority_text(view: GainView, on_path: bool) -> str:
-    """One line: the range of the predicted base decay rate along the path (TREP) or over the set (3R)."""
+    """One line: the range of the predicted base decay rate along the path (1-D RNS) or over the set."""
     where = "along the current reactionless path" if on_path else "over the reactionless-reachable set (dots)"
+    if not view.analysed:
+        return f"Authority {where}: not predicted for this model."
     auth = view.authority
     if auth is None or len(auth.base_decay_rate) == 0:
         return f"Authority {where}: being computed…"

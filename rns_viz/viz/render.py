@@ -29,9 +29,11 @@ from rns_viz.viz.gain_panel import GainExplorerView
 from rns_viz.viz.gui import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
+from rns_viz.viz.model_words import kick_hint, target_text
 from rns_viz.viz.panel_text import readouts_html, status_html
 from rns_viz.viz.rank_scene import RankScene
 from rns_viz.viz.scene import FsmsScene
+from rns_viz.viz.scene_nodes import node_names, resend_poses
 from rns_viz.viz.teach_scene import TeachScene
 from rns_viz.viz.view_toggles import ViewToggles
 
@@ -71,6 +73,7 @@ class Renderer:
         self.model_name = snap.settings.model
         self.explorer = GainExplorerView(server, session, gui, controls, connections)
         self._build_scene(snap)
+        self.names_drawn = node_names(server)  # every scene node name drawn so far (for rebuilds)
         self._seen = _Seen()
         self.sync_settings(snap)
         self._stop = threading.Event()
@@ -110,6 +113,8 @@ class Renderer:
         if self.base_panel is not None:
             self.base_panel.for_model(self.model)
         show_boom_presets(self.gui, snap.settings.model)
+        self.gui.target_text.content = target_text(self.model)
+        self.gui.kick_peak.hint = kick_hint(self.model)
         self.server.scene.add_label(
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
@@ -128,6 +133,9 @@ class Renderer:
         loop) is done again from a reset scene at the next frame, not left half-built for good."""
         self.server.scene.reset()
         self._build_scene(snap)
+        built = node_names(self.server)
+        resend_poses(self.server, built & self.names_drawn)  # a page may still hold a namesake's pose
+        self.names_drawn |= built
         g, controls = self.gui, self.controls
         with controls.quiet():
             defaults = defaults_for(snap.settings.model)
@@ -173,7 +181,7 @@ class Renderer:
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
             self._draw_overlays()
-        self.explorer.frame()  # the gain map, loci and authority, when the gain view changed
+        self.explorer.frame(self.model_name)  # the gain map, loci and authority, when the gain view changed
         if self.controls.take_handle_home_request():
             seen.target_version = -1
         self._draw_target(snap)
@@ -236,6 +244,9 @@ class Renderer:
 
     def _draw_overlays(self) -> None:
         ov = self.session.overlays()
+        if ov.model != self.model_name:  # a switch published after this frame's snapshot: drawn once rebuilt
+            self._seen.overlay_version = -1
+            return
         curves = list(ov.family or [])
         if ov.current is not None:
             curves.append(ov.current)
