@@ -6,9 +6,11 @@ transform drags) and drains what the server sends on a background thread, counti
 bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack windows and
 counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
 element (update rates for benchmarks). Like a browser it answers the server's localStorage
-questions (the app times them to pace slow pages, rns_viz.viz.client_pace); ``answer_delay_s``
-answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the answers back
-until ``thaw()``, as a frozen tab does. Only connects to loopback addresses (docs/testing-notes.md says why).
+questions (the app times them to pace slow pages, rns_viz.viz.client_pace) from its ``storage`` (a dict:
+give two clients the same one and they are tabs of one browser, or a page and its reload);
+``answer_delay_s`` answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the
+answers back until ``thaw()``, as a frozen tab does. Only connects to loopback addresses
+(docs/testing-notes.md says why).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ class ProtocolClient:
         decode: bool = False,
         watch_node: str = "/base",
         answer_delay_s: float = 0.0,
+        storage: dict[str, str] | None = None,
     ) -> None:
         if not (host.startswith("127.") or host in ("localhost", "::1")):
             raise ValueError("protocol clients only connect to this machine")
@@ -61,9 +64,12 @@ class ProtocolClient:
         self.pose_times: list[float] = []  # perf_counter times of windows that moved ``watch_node``
         self.gui_times: dict[str, list[float]] = {}  # uuid -> perf_counter times of its updates
         self.answer_delay_s = answer_delay_s  # s: how late the page answers the server's questions
+        self.storage = {} if storage is None else storage  # the browser's localStorage (viser's keys)
         self.frozen = threading.Event()  # set: questions wait for thaw()
-        self._deferred: list[str] = []
+        self._deferred: list[tuple[str, str]] = []
         self.answers = 0
+        self.answers_to: Counter[str] = Counter()  # localStorage key -> questions answered about it
+        self.notifications: list[tuple[str, str]] = []  # (title, body) of every notification shown to this tab
         self.closed = threading.Event()
         self._zstd = zstandard.ZstdDecompressor()
         self._lock = threading.Lock()
@@ -169,18 +175,23 @@ class ProtocolClient:
         compressed = int.from_bytes(frame[8:16], "little")
         window = msgspec.msgpack.decode(self._zstd.decompress(frame[16 : 16 + compressed], max_output_size=size))
         for msg in window["messages"]:
-            if msg.get("type") == "LocalStorageGetItemRequestMessage":
-                self._answer(msg["request_uuid"])
+            if msg.get("type") == "NotificationShowMessage":
+                self.notifications.append((msg["props"]["title"], msg["props"]["body"]))
+            elif msg.get("type") == "LocalStorageSetItemMessage":
+                self.storage[msg["key"]] = msg["value"]
+            elif msg.get("type") == "LocalStorageGetItemRequestMessage":
+                self._answer(msg["request_uuid"], msg["key"])
         if self.decode:
             self._count(window["messages"], now)
 
-    def _answer(self, request_uuid: str) -> None:
+    def _answer(self, request_uuid: str, key: str) -> None:
         """Answer a localStorage question now, later (``answer_delay_s``) or, while ``frozen``, on
         :meth:`thaw`."""
         if self.frozen.is_set():
-            self._deferred.append(request_uuid)
+            self._deferred.append((request_uuid, key))
             return
-        reply = _messages.LocalStorageGetItemResponseMessage(value=None, error=None, request_uuid=request_uuid)
+        value = self.storage.get(key)
+        reply = _messages.LocalStorageGetItemResponseMessage(value=value, error=None, request_uuid=request_uuid)
         if self.answer_delay_s > 0.0:
             timer = threading.Timer(self.answer_delay_s, self._send_quietly, (reply,))
             timer.daemon = True
@@ -188,13 +199,14 @@ class ProtocolClient:
         else:
             self._send_quietly(reply)
         self.answers += 1
+        self.answers_to[key] += 1
 
     def thaw(self) -> None:
         """Answer the questions that came while frozen (in order, as a thawed tab does), then go on."""
         self.frozen.clear()
         deferred, self._deferred = self._deferred, []
-        for request_uuid in deferred:
-            self._answer(request_uuid)
+        for request_uuid, key in deferred:
+            self._answer(request_uuid, key)
 
     def _send_quietly(self, message: _messages.Message) -> None:
         with contextlib.suppress(ConnectionClosed, OSError):
