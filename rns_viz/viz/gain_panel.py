@@ -144,7 +144,11 @@ class GainExplorerView:
         else:
             self.scene.show_now(view)
         drawn = self._drawn  # send only what changed: the parts of a view are new objects when they change
-        if map_changed or not _same((view.authority, view.path_points), drawn.get("authority")):
+        last = drawn.get("authority")
+        # new gains: the path keeps its colours the few ms until the authority at them arrives (no blinking
+        # while a slider is dragged); a new path, model or map is drawn at once
+        recolouring = view.authority is None and isinstance(last, tuple) and last[1] is view.path_points
+        if map_changed or not (_same((view.authority, view.path_points), last) or recolouring):
             drawn["authority"] = (view.authority, view.path_points)
             self.scene.show_authority(view, self.on_path)
         self._show_text(view)

@@ -18,6 +18,7 @@ import viser
 from rns_viz.defaults import defaults_for
 from rns_viz.live.dual import is_dual
 from rns_viz.live.laws import LAW_LABELS
+from rns_viz.live.rank_view import has_rank_inset
 from rns_viz.live.readouts import arm_reach
 from rns_viz.live.records import Snapshot
 from rns_viz.live.replay import replay_snapshot
@@ -115,6 +116,8 @@ class Renderer:
         show_boom_presets(self.gui, snap.settings.model)
         self.gui.target_text.content = target_text(self.model)
         self.gui.kick_peak.hint = kick_hint(self.model)
+        if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
+            self.view.boxes["rank"].visible = has_rank_inset(self.model)
         self.server.scene.add_label(
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
