@@ -19,6 +19,7 @@ import contextlib
 import threading
 import time
 from collections import Counter
+from dataclasses import dataclass
 from typing import Any
 
 import msgspec.msgpack
@@ -30,6 +31,51 @@ from websockets.sync.client import ClientConnection, connect
 
 _SCENE_POSE = ("SetPositionMessage", "SetOrientationMessage")
 _IDENTITY = (1.0, 0.0, 0.0, 0.0)
+_MESSAGE_CLASSES = {c.__name__: c for c in _messages.Message.get_subclasses()}
+
+
+@dataclass
+class MirroredNode:
+    """A scene node as viser's page holds it: its pose (parent frame) and visibility."""
+
+    position: tuple[float, ...] = (0.0, 0.0, 0.0)
+    wxyz: tuple[float, ...] = _IDENTITY
+    visible: bool = True
+
+
+class SceneMirror:
+    """The scene as viser's page (1.1.1, SceneTreeState.ts) keeps it from the messages it receives: a create
+    for a name it has updates that node and keeps its pose and visibility; a remove takes the name and what
+    hangs below it; pose and visibility messages set them. Compare it with the server's handles to see what a
+    browser shows."""
+
+    def __init__(self) -> None:
+        self.nodes: dict[str, MirroredNode] = {}
+        self.lock = threading.Lock()
+
+    def apply(self, msg: dict[str, Any]) -> None:
+        cls = _MESSAGE_CLASSES.get(msg.get("type", ""))
+        if cls is None or cls.entity_type != "scene" or msg.get("owner", ""):
+            return  # not a node of the shared scene
+        name, kind = msg["name"], msg["type"]
+        with self.lock:
+            if cls.lifecycle_phase == "create":
+                self.nodes.setdefault(name, MirroredNode())
+            elif cls.lifecycle_phase == "remove":
+                for gone in [n for n in self.nodes if n == name or n.startswith(name + "/")]:
+                    del self.nodes[gone]
+            elif name in self.nodes:
+                node = self.nodes[name]
+                if kind == "SetPositionMessage":
+                    node.position = tuple(msg["position"])
+                elif kind == "SetOrientationMessage":
+                    node.wxyz = tuple(msg["wxyz"])
+                elif kind == "SetSceneNodeVisibilityMessage":
+                    node.visible = bool(msg["visible"])
+
+    def snapshot(self) -> dict[str, MirroredNode]:
+        with self.lock:
+            return {name: MirroredNode(n.position, n.wxyz, n.visible) for name, n in self.nodes.items()}
 
 
 class ProtocolClient:
@@ -44,6 +90,7 @@ class ProtocolClient:
         watch_node: str = "/base",
         answer_delay_s: float = 0.0,
         storage: dict[str, str] | None = None,
+        mirror: bool = False,
     ) -> None:
         if not (host.startswith("127.") or host in ("localhost", "::1")):
             raise ValueError("protocol clients only connect to this machine")
@@ -70,6 +117,7 @@ class ProtocolClient:
         self.answers = 0
         self.answers_to: Counter[str] = Counter()  # localStorage key -> questions answered about it
         self.notifications: list[tuple[str, str]] = []  # (title, body) of every notification shown to this tab
+        self.scene = SceneMirror() if mirror else None  # the scene as a browser would hold it
         self.closed = threading.Event()
         self._zstd = zstandard.ZstdDecompressor()
         self._lock = threading.Lock()
@@ -175,6 +223,8 @@ class ProtocolClient:
         compressed = int.from_bytes(frame[8:16], "little")
         window = msgspec.msgpack.decode(self._zstd.decompress(frame[16 : 16 + compressed], max_output_size=size))
         for msg in window["messages"]:
+            if self.scene is not None:
+                self.scene.apply(msg)
             if msg.get("type") == "NotificationShowMessage":
                 self.notifications.append((msg["props"]["title"], msg["props"]["body"]))
             elif msg.get("type") == "LocalStorageSetItemMessage":
