@@ -30,7 +30,7 @@ def join(app: RnsApp, storage: dict[str, str]) -> tuple[ProtocolClient, int]:
     tab = ProtocolClient(app.port, storage=storage)
     wait_until(lambda: len(set(app.lock.clients()) - before) == 1, 10.0, "the tab to connect")
     (cid,) = set(app.lock.clients()) - before
-    wait_until(lambda: app.lock.browser(cid) is not None, 10.0, "the tab's browser to be known")
+    wait_until(lambda: app.lock.browser(cid) and BROWSER_KEY in storage, 10.0, "the tab's browser to be known")
     assert app.lock.browser(cid) == storage[BROWSER_KEY]
     return tab, cid
 

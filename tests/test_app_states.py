@@ -11,12 +11,8 @@ The default run is bounded (derandomised, a few examples of 20 steps); ``python 
 
 from __future__ import annotations
 
-import shutil
-import threading
 import time
-import traceback
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -27,12 +23,12 @@ from hypothesis.stateful import RuleBasedStateMachine, invariant, rule, run_stat
 
 from rns_viz.defaults import defaults_for
 from rns_viz.live.commands import LIVE_LAWS
-from rns_viz.params import ASSETS_DIR
 from rns_viz.scenarios import LIVE_SCENARIOS
 from rns_viz.viz.app import IDLE_RESTART_S, RnsApp, start_app
 from rns_viz.viz.connections import BROWSER_KEY
 from rns_viz.viz.lesson_panel import CHOICES
 from rns_viz.viz.scene_nodes import node_names
+from tests.app_helpers import Faults, user_model
 from tests.app_invariants import DYNAMIC, drawn_violations, page_violations, published_violations
 from tests.browser import wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
@@ -41,16 +37,6 @@ BUNDLED = ("trep", "planar3r", "boom7", "trep2")
 MISSING_EXTRA = ("boom-panda",)  # the panda extra is not installed here: refused with the install command
 SELECTIONS = ((True,) * 6, (True, True, True, False, False, False), (True, False) * 3, (True,), (False,))
 SETTLE_S = 20.0  # s: how long what the render thread and the tabs show may take to catch up
-
-
-def user_model(folder: Path) -> str:
-    """A user's model file: the planar 3R's URDF and parameters under another name."""
-    shutil.copy(ASSETS_DIR / "planar3r.urdf", folder / "my_arm.urdf")
-    text = (ASSETS_DIR / "planar3r.toml").read_text()
-    text = text.replace('name = "planar3r"', 'name = "my_arm"').replace('"planar3r.urdf"', '"my_arm.urdf"')
-    path = folder / "my_arm.toml"
-    path.write_text(text)
-    return str(path.resolve())
 
 
 def reference_nodes(models: tuple[str, ...]) -> dict[str, set[str]]:
@@ -62,27 +48,6 @@ def reference_nodes(models: tuple[str, ...]) -> dict[str, set[str]]:
         out[model] = {name for name in node_names(app.server) if not name.startswith(DYNAMIC)}
         app.stop()
     return out
-
-
-class Faults:
-    """Every exception a thread, worker or callback reported (traceback.print_exc, threading.excepthook)."""
-
-    def __init__(self) -> None:
-        self.seen: list[str] = []
-
-    def install(self, monkeypatch: pytest.MonkeyPatch) -> None:
-        print_exc, hook = traceback.print_exc, threading.excepthook
-
-        def record_print_exc(*args: Any, **kwargs: Any) -> None:
-            self.seen.append(traceback.format_exc())
-            print_exc(*args, **kwargs)
-
-        def record_hook(exc: threading.ExceptHookArgs) -> None:
-            self.seen.append(f"{exc.thread}: {exc.exc_type.__name__}: {exc.exc_value}")
-            hook(exc)
-
-        monkeypatch.setattr(traceback, "print_exc", record_print_exc)
-        monkeypatch.setattr(threading, "excepthook", record_hook)
 
 
 class Tab:
@@ -357,7 +322,7 @@ class AppStates(RuleBasedStateMachine):
 
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory: pytest.TempPathFactory) -> type[AppStates]:
-    AppStates.model_file = user_model(tmp_path_factory.mktemp("model"))
+    AppStates.model_file = str(user_model(tmp_path_factory.mktemp("model")).resolve())
     AppStates.references = reference_nodes((*BUNDLED, AppStates.model_file))
     return AppStates
 

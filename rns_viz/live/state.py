@@ -82,10 +82,9 @@ class LiveState:
         self._new_operator(theta0)
         self.settings = replace(self.settings, preset=None)
         self._restart_bookkeeping()
-        op = self.operator
         self._explore(theta0)  # before any geometry is taken: the explorer is on this model from here on
         table = self.geometry.default_tables.get(name) if theta is None else None
-        if table is not None and op is not None and op.accept_table(table, self.tol):
+        if table is not None and self.operator is not None and self.operator.accept_table(table, self.tol):
             self._took_table(table, default=True)
         else:
             self._request_geometry(theta0, default=True)
@@ -102,8 +101,7 @@ class LiveState:
         self.runs.install(self._choice(), op.joint, op.law_task(self.settings.law), op.joint_move is not None)
 
     def _restart_bookkeeping(self) -> None:
-        """A new epoch: the run restarted (reset, model switch, preset, selection). A lesson goes on only on
-        its own model (a preset or selection of it); what the old epoch published is cleared."""
+        """A new epoch (reset, model switch, preset, selection); a lesson goes on only on its own model."""
         self.epoch += 1
         if self.lesson is not None and model_source(self.model.name) != self.lesson.model:
             self.lesson = None
@@ -137,13 +135,8 @@ class LiveState:
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
-        self.settings = replace(
-            Settings.defaults(self.model.name, st.shadow, st.speed),
-            law=choice.kind,
-            gains=choice.gains,
-            suppress=choice.suppress,
-            preset=name,
-        )
+        defaults = Settings.defaults(self.model.name, st.shadow, st.speed)
+        self.settings = replace(defaults, law=choice.kind, gains=choice.gains, suppress=choice.suppress, preset=name)
         self._restart_bookkeeping()
         self.paused = self._preset_paused
         self._request_geometry(runs.theta)
