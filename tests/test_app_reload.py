@@ -12,22 +12,20 @@ import pytest
 from rns_viz.viz import app as app_module
 from rns_viz.viz.app import RnsApp, start_app
 from rns_viz.viz.connections import BROWSER_KEY
+from tests.app_helpers import stepped_app
 from tests.browser import wait_until
 from tests.protocol_client import ProtocolClient, gui_uuid
 
 
 @pytest.fixture
 def app() -> Iterator[RnsApp]:
-    app = start_app("trep", port=0, realtime=False, verbose=False)
-    assert app.session.wait_background()
-    yield app
-    app.stop()
+    yield from stepped_app("trep")
 
 
 def join(app: RnsApp, storage: dict[str, str]) -> tuple[ProtocolClient, int]:
     """A tab of the browser whose localStorage is ``storage``, connected and identified; (tab, client id)."""
     before = set(app.lock.clients())
-    tab = ProtocolClient(app.port, storage=storage)
+    tab = ProtocolClient(app.port, storage=storage, decode=True)
     wait_until(lambda: len(set(app.lock.clients()) - before) == 1, 10.0, "the tab to connect")
     (cid,) = set(app.lock.clients()) - before
     wait_until(lambda: app.lock.browser(cid) and BROWSER_KEY in storage, 10.0, "the tab's browser to be known")
@@ -101,3 +99,25 @@ def test_a_session_nobody_watched_for_a_while_restarts_for_its_first_visitor(app
     s.advance(0.001)
     assert s.snapshot().epoch != epoch and s.snapshot().t < 0.01
     c.close()
+
+
+def test_a_browser_that_gave_the_password_is_not_asked_again_after_a_reload() -> None:
+    app = start_app("trep", port=0, realtime=False, verbose=False, password="s3cret")
+    try:
+        browser: dict[str, str] = {}
+        before = set(app.lock.clients())
+        a = ProtocolClient(app.port, storage=browser, decode=True)
+        wait_until(lambda: a.types["GuiModalMessage"] == 1, 10.0, "the password to be asked")
+        (a_id,) = set(app.lock.clients()) - before
+        assert app.lock.operator is None and app.lock.authenticate(a_id, "s3cret") and app.lock.is_operator(a_id)
+        a.close()
+        a2, a2_id = join(app, browser)
+        wait_until(lambda: app.lock.is_operator(a2_id), 10.0, "the reloaded page to operate again")
+        assert app.lock.may_operate(a2_id) and a2.types["GuiModalMessage"] == 0  # not asked again
+        stranger, stranger_id = join(app, {})
+        wait_until(lambda: stranger.types["GuiModalMessage"] == 1, 10.0, "another browser to be asked")
+        assert not app.lock.may_operate(stranger_id)
+        for tab in (a2, stranger):
+            tab.close()
+    finally:
+        app.stop()

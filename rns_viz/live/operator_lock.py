@@ -144,6 +144,11 @@ class OperatorLock:
             if self.operator == client:
                 self._set(None)
 
+    def may_operate(self, client: int) -> bool:
+        """``client`` may hold the lock (no password is set, or it or its browser gave it)."""
+        with self._lock:
+            return self._eligible(client)
+
     def browser(self, client: int) -> str | None:
         """The token of ``client``'s browser, once identified."""
         return self._browser.get(client)
