@@ -6,7 +6,6 @@ fault, and the app keeps the model it runs. A headless server driven by protocol
 
 from __future__ import annotations
 
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -14,26 +13,12 @@ import numpy as np
 import pytest
 
 from rns_viz.cli import main
-from rns_viz.params import ASSETS_DIR
 from rns_viz.viz.panels.base_panel import BasePanel
 from rns_viz.viz.panels.model_menu import MODEL_LABELS
 from rns_viz.viz.server.app import RnsApp, start_app
+from tests.support.app_helpers import user_model
 from tests.support.browser import wait_for_clients, wait_until
 from tests.support.protocol_client import ProtocolClient, gui_uuid
-
-
-def user_model(folder: Path) -> Path:
-    """A user's own model: the planar 3R's URDF and parameters under another name, in another folder."""
-    shutil.copy(ASSETS_DIR / "planar3r.urdf", folder / "my_arm.urdf")
-    text = (ASSETS_DIR / "planar3r.toml").read_text()
-    text = text.replace('name = "planar3r"', 'name = "my_arm"').replace('"planar3r.urdf"', '"my_arm.urdf"')
-    path = folder / "my_arm.toml"
-    path.write_text(
-        text.replace(
-            "default_configuration_deg = [60.0, -60.0, -60.0]", "default_configuration_deg = [50.0, -60.0, -60.0]"
-        )
-    )
-    return path
 
 
 @pytest.fixture

@@ -54,7 +54,10 @@ def test_divergence_pauses_keeps_the_last_finite_state_and_reset_recovers(trep_a
 
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
-def test_a_client_leaving_mid_drag_does_not_hurt(trep_app: RnsApp, client: ProtocolClient) -> None:
+def test_a_client_leaving_mid_drag_does_not_hurt(
+    trep_app: RnsApp, client: ProtocolClient, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr("rns_viz.live.operator.operator_lock.RELOAD_GRACE_S", 0.0)  # no wait for a reload of its page
     s = trep_app.session
     ee = trep_app.model.ee_position(s.snapshot().q[1:])
     client.drag(TARGET_HANDLE, (ee[0] + 0.02, ee[1], ee[2]), "start")

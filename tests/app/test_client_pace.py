@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.server.app import RnsApp, start_app
+from rns_viz.viz.server.page_pacing import PING_KEY
 from rns_viz.viz.server.page_rate import (
     FULL_HZ,
     SLOW_ANSWER_S,
@@ -93,12 +94,12 @@ def test_a_page_with_nothing_new_to_show_is_asked_nothing() -> None:
         page = app.pace.pages[client_id(app, set())]
         wait_until(lambda: page.answered_once, 10.0, "the first answer")
         time.sleep(1.0)  # the first scene and panel have gone out
-        asked = client.answers
+        asked = client.answers_to[PING_KEY]
         time.sleep(1.5)  # six question gaps (PING_GAP_S) with nothing sent
-        assert client.answers == asked, "a page with nothing new to show was asked"
+        assert client.answers_to[PING_KEY] == asked, "a page with nothing new to show was asked"
         app.session.kick(5.0)
         app.session.advance(0.5)  # the arm and base move: new poses go out
-        wait_until(lambda: client.answers > asked, 10.0, "a question once the stream moved")
+        wait_until(lambda: client.answers_to[PING_KEY] > asked, 10.0, "a question once the stream moved")
         assert app.pace.state(page.client.client_id)["hz"] == FULL_HZ  # a page that keeps up
     finally:
         client.close()
@@ -116,13 +117,13 @@ def test_a_running_app_at_rest_asks_nothing_while_only_the_panel_changes() -> No
         page = app.pace.pages[client_id(app, set())]
         wait_until(lambda: page.answered_once, 10.0, "the first answer")
         time.sleep(1.5)  # the first scene and panel have gone out, the last question answered
-        asked, panel, poses = client.answers, sum(client.gui_updates.values()), len(client.pose_times)
+        asked, panel, poses = client.answers_to[PING_KEY], sum(client.gui_updates.values()), len(client.pose_times)
         time.sleep(1.5)  # six question gaps (PING_GAP_S)
         assert sum(client.gui_updates.values()) > panel + 5, "the running app's panel did not stream"
         assert len(client.pose_times) == poses, "the resting arm was sent new poses"
-        assert client.answers == asked, "a page with only panel updates was asked"
+        assert client.answers_to[PING_KEY] == asked, "a page with only panel updates was asked"
         app.session.kick(0.8)
-        wait_until(lambda: client.answers > asked, 10.0, "a question once the scene moved")
+        wait_until(lambda: client.answers_to[PING_KEY] > asked, 10.0, "a question once the scene moved")
     finally:
         client.close()
         app.stop()
@@ -134,7 +135,7 @@ def test_pacing_switched_off_sends_every_client_everything() -> None:
     try:
         wait_for_clients(app, 1, "a client")
         time.sleep(1.0)
-        assert app.pace.pages == {} and slow.answers == 0  # no questions asked
+        assert app.pace.pages == {} and slow.answers_to[PING_KEY] == 0  # no pace questions asked
     finally:
         slow.close()
         app.stop()

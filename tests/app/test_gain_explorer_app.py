@@ -155,7 +155,17 @@ def test_malformed_clicks_do_not_crash_the_server(app: RnsApp, clients: tuple[Pr
     wait_until(applied_now, 15.0, "a good click after the bad ones")
 
 
+def authority_drawn(app: RnsApp) -> bool:
+    """The loop has taken the authority at the gains in force (new gains clear it until it is computed
+    again) and the render thread has drawn that view."""
+    app.session.advance(0.005)
+    view, ex = app.session.gain_view(), explorer(app)
+    drawn = ex._drawn.get("authority")
+    return isinstance(drawn, tuple) and drawn[0] is view.authority is not None and drawn[1] is view.path_points
+
+
 def test_the_drawn_authority_colours_are_the_predicted_rates(app: RnsApp) -> None:
+    wait_until(lambda: authority_drawn(app), 30.0, "the authority at the gains in force, drawn")
     view = app.session.gain_view()
     scene = explorer(app).scene
     assert scene is not None and view.authority is not None and view.path_points is not None

@@ -1,12 +1,20 @@
 """What the app and session tests share: a stepped app, a real-time app, a stepped session, boom7 kicked
-in every row, a lesson driver, a handle's uuid, waiting for queued commands."""
+in every row, a lesson driver, a handle's uuid, waiting for queued commands, a user's model file, the
+exceptions threads reported."""
 
 from __future__ import annotations
 
+import shutil
+import threading
+import traceback
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
+import pytest
+
 from rns_viz.live.loop.session import Session
+from rns_viz.params import ASSETS_DIR
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import wait_until
 
@@ -74,3 +82,39 @@ def uuid(handle: object) -> str:
 def queued(app: RnsApp, kind: str, count: int = 1) -> None:
     """Wait until the GUI callbacks (viser's thread pool) have queued ``count`` commands of ``kind``."""
     wait_until(lambda: app.session.pending_commands().count(kind) >= count, 10.0, f"{count} '{kind}' command(s)")
+
+
+def user_model(folder: Path) -> Path:
+    """A user's own model: the planar 3R's URDF and parameters under another name, in another folder."""
+    shutil.copy(ASSETS_DIR / "planar3r.urdf", folder / "my_arm.urdf")
+    text = (ASSETS_DIR / "planar3r.toml").read_text()
+    text = text.replace('name = "planar3r"', 'name = "my_arm"').replace('"planar3r.urdf"', '"my_arm.urdf"')
+    path = folder / "my_arm.toml"
+    path.write_text(
+        text.replace(
+            "default_configuration_deg = [60.0, -60.0, -60.0]", "default_configuration_deg = [50.0, -60.0, -60.0]"
+        )
+    )
+    return path
+
+
+class Faults:
+    """Every exception a thread, worker or callback reported: the app's threads print what they catch
+    (traceback.print_exc), uncaught ones reach threading.excepthook. ``install`` for the test's duration."""
+
+    def __init__(self) -> None:
+        self.seen: list[str] = []
+
+    def install(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        print_exc, hook = traceback.print_exc, threading.excepthook
+
+        def record_print_exc(*args: Any, **kwargs: Any) -> None:
+            self.seen.append(traceback.format_exc())
+            print_exc(*args, **kwargs)
+
+        def record_hook(exc: threading.ExceptHookArgs) -> None:
+            self.seen.append(f"{exc.thread}: {exc.exc_type.__name__}: {exc.exc_value}")
+            hook(exc)
+
+        monkeypatch.setattr(traceback, "print_exc", record_print_exc)
+        monkeypatch.setattr(threading, "excepthook", record_hook)

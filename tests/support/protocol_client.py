@@ -6,9 +6,11 @@ transform drags) and drains what the server sends on a background thread, counti
 bytes. With ``decode=True`` it also unpacks the server's zstd-compressed msgpack windows and
 counts message types, scene nodes touched, pose updates of ``watch_node`` and GUI updates per
 element (update rates for benchmarks). Like a browser it answers the server's localStorage
-questions (the app times them to pace slow pages, rns_viz.viz.server.page_pacing); ``answer_delay_s``
-answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the answers back
-until ``thaw()``, as a frozen tab does. Only connects to loopback addresses (docs/testing-notes.md says why).
+questions (the app times them to pace slow pages, rns_viz.viz.server.page_pacing) from its ``storage`` (a
+dict: give two clients the same one and they are tabs of one browser, or a page and its reload);
+``answer_delay_s`` answers late, as a page that draws slowly does, and ``frozen`` (an Event) holds the
+answers back until ``thaw()``, as a frozen tab does. Only connects to loopback addresses
+(docs/testing-notes.md says why).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import contextlib
 import threading
 import time
 from collections import Counter
+from dataclasses import dataclass
 from typing import Any
 
 import msgspec.msgpack
@@ -28,6 +31,51 @@ from websockets.sync.client import ClientConnection, connect
 
 _SCENE_POSE = ("SetPositionMessage", "SetOrientationMessage")
 _IDENTITY = (1.0, 0.0, 0.0, 0.0)
+_MESSAGE_CLASSES = {c.__name__: c for c in _messages.Message.get_subclasses()}
+
+
+@dataclass
+class MirroredNode:
+    """A scene node as viser's page holds it: its pose (parent frame) and visibility."""
+
+    position: tuple[float, ...] = (0.0, 0.0, 0.0)
+    wxyz: tuple[float, ...] = _IDENTITY
+    visible: bool = True
+
+
+class SceneMirror:
+    """The scene as viser's page (1.1.1, SceneTreeState.ts) keeps it from the messages it receives: a create
+    for a name it has updates that node and keeps its pose and visibility; a remove takes the name and what
+    hangs below it; pose and visibility messages set them. Compare it with the server's handles to see what a
+    browser shows."""
+
+    def __init__(self) -> None:
+        self.nodes: dict[str, MirroredNode] = {}
+        self.lock = threading.Lock()
+
+    def apply(self, msg: dict[str, Any]) -> None:
+        cls = _MESSAGE_CLASSES.get(msg.get("type", ""))
+        if cls is None or cls.entity_type != "scene" or msg.get("owner", ""):
+            return  # not a node of the shared scene
+        name, kind = msg["name"], msg["type"]
+        with self.lock:
+            if cls.lifecycle_phase == "create":
+                self.nodes.setdefault(name, MirroredNode())
+            elif cls.lifecycle_phase == "remove":
+                for gone in [n for n in self.nodes if n == name or n.startswith(name + "/")]:
+                    del self.nodes[gone]
+            elif name in self.nodes:
+                node = self.nodes[name]
+                if kind == "SetPositionMessage":
+                    node.position = tuple(msg["position"])
+                elif kind == "SetOrientationMessage":
+                    node.wxyz = tuple(msg["wxyz"])
+                elif kind == "SetSceneNodeVisibilityMessage":
+                    node.visible = bool(msg["visible"])
+
+    def snapshot(self) -> dict[str, MirroredNode]:
+        with self.lock:
+            return {name: MirroredNode(n.position, n.wxyz, n.visible) for name, n in self.nodes.items()}
 
 
 class ProtocolClient:
@@ -41,6 +89,8 @@ class ProtocolClient:
         decode: bool = False,
         watch_node: str = "/base",
         answer_delay_s: float = 0.0,
+        storage: dict[str, str] | None = None,
+        mirror: bool = False,
     ) -> None:
         if not (host.startswith("127.") or host in ("localhost", "::1")):
             raise ValueError("protocol clients only connect to this machine")
@@ -61,9 +111,13 @@ class ProtocolClient:
         self.pose_times: list[float] = []  # perf_counter times of windows that moved ``watch_node``
         self.gui_times: dict[str, list[float]] = {}  # uuid -> perf_counter times of its updates
         self.answer_delay_s = answer_delay_s  # s: how late the page answers the server's questions
+        self.storage = {} if storage is None else storage  # the browser's localStorage (viser's keys)
         self.frozen = threading.Event()  # set: questions wait for thaw()
-        self._deferred: list[str] = []
+        self._deferred: list[tuple[str, str]] = []
         self.answers = 0
+        self.answers_to: Counter[str] = Counter()  # localStorage key -> questions answered about it
+        self.notifications: list[tuple[str, str]] = []  # (title, body) of every notification shown to this tab
+        self.scene = SceneMirror() if mirror else None  # the scene as a browser would hold it
         self.closed = threading.Event()
         self._zstd = zstandard.ZstdDecompressor()
         self._lock = threading.Lock()
@@ -169,18 +223,25 @@ class ProtocolClient:
         compressed = int.from_bytes(frame[8:16], "little")
         window = msgspec.msgpack.decode(self._zstd.decompress(frame[16 : 16 + compressed], max_output_size=size))
         for msg in window["messages"]:
-            if msg.get("type") == "LocalStorageGetItemRequestMessage":
-                self._answer(msg["request_uuid"])
+            if self.scene is not None:
+                self.scene.apply(msg)
+            if msg.get("type") == "NotificationShowMessage":
+                self.notifications.append((msg["props"]["title"], msg["props"]["body"]))
+            elif msg.get("type") == "LocalStorageSetItemMessage":
+                self.storage[msg["key"]] = msg["value"]
+            elif msg.get("type") == "LocalStorageGetItemRequestMessage":
+                self._answer(msg["request_uuid"], msg["key"])
         if self.decode:
             self._count(window["messages"], now)
 
-    def _answer(self, request_uuid: str) -> None:
+    def _answer(self, request_uuid: str, key: str) -> None:
         """Answer a localStorage question now, later (``answer_delay_s``) or, while ``frozen``, on
         :meth:`thaw`."""
         if self.frozen.is_set():
-            self._deferred.append(request_uuid)
+            self._deferred.append((request_uuid, key))
             return
-        reply = _messages.LocalStorageGetItemResponseMessage(value=None, error=None, request_uuid=request_uuid)
+        value = self.storage.get(key)
+        reply = _messages.LocalStorageGetItemResponseMessage(value=value, error=None, request_uuid=request_uuid)
         if self.answer_delay_s > 0.0:
             timer = threading.Timer(self.answer_delay_s, self._send_quietly, (reply,))
             timer.daemon = True
@@ -188,13 +249,14 @@ class ProtocolClient:
         else:
             self._send_quietly(reply)
         self.answers += 1
+        self.answers_to[key] += 1
 
     def thaw(self) -> None:
         """Answer the questions that came while frozen (in order, as a thawed tab does), then go on."""
         self.frozen.clear()
         deferred, self._deferred = self._deferred, []
-        for request_uuid in deferred:
-            self._answer(request_uuid)
+        for request_uuid, key in deferred:
+            self._answer(request_uuid, key)
 
     def _send_quietly(self, message: _messages.Message) -> None:
         with contextlib.suppress(ConnectionClosed, OSError):

@@ -51,8 +51,8 @@ def test_a_reach_request_overtakes_the_gain_explorers_sweep(monkeypatch: pytest.
     monkeypatch.setattr(jobs._Helper, "_exchange", watched)
     explorer, background = GainExplorer(), Background()
     try:
-        explorer.context("boom7", "acceleration", theta0, gains)
-        explorer.along(thetas, ee)
+        explorer.context(0, "boom7", "acceleration", theta0, gains)
+        explorer.along("boom7", thetas, ee)
         assert mid_sweep.wait(300.0)
         asked = len(started)
         background.reach(0, FORCES_ONLY_KEY, theta0)

@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from rns_viz.live.operator.operator_lock import LockRefused, OperatorLock
+from rns_viz.live.operator.operator_lock import RELOAD_GRACE_S, LockRefused, OperatorLock
 
 
 def test_first_client_operates_and_control_passes_on_in_order_of_arrival() -> None:
@@ -68,3 +68,69 @@ def test_concurrent_requests_leave_exactly_one_operator() -> None:
         t.join()
     assert lock.operator in range(16) and lock.version > version
     assert sum(lock.is_operator(c) for c in range(16)) == 1
+
+
+class Clock:
+    """A wall clock the test moves by hand (s)."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_a_reloaded_operators_page_gets_control_back_within_the_grace() -> None:
+    clock = Clock()
+    lock = OperatorLock(clock=clock)
+    lock.connect(1)
+    lock.connect(2)
+    lock.identify(1, "browser-a")
+    lock.identify(2, "browser-b")
+    assert lock.disconnect(1) is None and lock.operator is None  # kept for browser a, not passed to 2
+    assert "reloading" in lock.status(2)
+    assert not lock.connect(3) and lock.operator is None  # the reload's new connection, not identified yet
+    clock.now = RELOAD_GRACE_S - 1.0
+    assert lock.expire() is None
+    assert lock.identify(3, "browser-a") and lock.is_operator(3)
+    assert lock.expire() is None and lock.is_operator(3)
+
+
+def test_a_kept_lock_passes_on_when_the_page_does_not_come_back() -> None:
+    clock = Clock()
+    lock = OperatorLock(clock=clock)
+    lock.connect(1)
+    lock.connect(2)
+    lock.identify(1, "browser-a")
+    lock.disconnect(1)
+    clock.now = RELOAD_GRACE_S + 0.1
+    assert lock.expire() == 2 and lock.is_operator(2)
+    lock.connect(3)
+    assert not lock.identify(3, "browser-a") and lock.is_operator(2)  # too late: 2 keeps control
+
+
+def test_a_reload_that_arrives_before_the_old_page_leaves_operates_at_once() -> None:
+    lock = OperatorLock()
+    lock.connect(1)
+    lock.connect(2)  # a watcher in another browser
+    lock.identify(1, "browser-a")
+    lock.connect(3)
+    lock.identify(3, "browser-a")  # the reloaded page is here first
+    assert lock.is_operator(1)
+    assert lock.disconnect(1) == 3 and lock.is_operator(3)
+
+
+def test_taking_control_ends_a_kept_lock_and_a_browser_keeps_its_password() -> None:
+    lock = OperatorLock("s3cret")
+    lock.connect(1)
+    lock.identify(1, "browser-a")
+    assert lock.authenticate(1, "s3cret") and lock.is_operator(1)
+    lock.connect(2)
+    lock.disconnect(1)
+    lock.connect(3)
+    assert lock.identify(3, "browser-a") and lock.is_operator(3)  # no password asked again after a reload
+    lock.disconnect(3)
+    with pytest.raises(LockRefused):
+        lock.take(2)  # client 2 never gave the password
+    lock.take(2, "s3cret")
+    assert lock.is_operator(2) and "reloading" not in lock.status(2)

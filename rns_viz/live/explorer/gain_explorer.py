@@ -8,6 +8,12 @@ loop fits the decay of the measured base deflection, to set beside the predictio
 
 The loop calls :meth:`GainExplorer.context`, :meth:`retune`, :meth:`along`, :meth:`kicked` and
 :meth:`measure`; :meth:`collect` takes finished results. Readers take :attr:`GainExplorer.view`.
+
+The view says what it belongs to (the loop's epoch, the model, the law and the gains), and every part
+of it is of those or absent (None while it is computed): a result of another model, law, configuration
+or gains is dropped when it arrives, and a change of any of them clears the parts it makes untrue in the
+same published view. A measurement names its model, gains, epoch and kick; it is forgotten when any of
+them changes (a decay measured at other gains is no test of this prediction).
 """
 
 from __future__ import annotations
@@ -45,11 +51,15 @@ FIT_UNTIL_S = 20.0  # ... until this long after it
 
 @dataclass(frozen=True)
 class Measured:
-    """The decay of the measured base deflection after the last kick."""
+    """The decay of the measured base deflection after the last kick, and what it was measured on."""
 
     rate: float  # 1/s, fitted to the peaks of |x_b|
     since: float  # s, the kick's time
     seconds: float  # s of log fitted
+    model: str  # the model key
+    law: LawKind
+    gains: Gains  # in force from the kick to the end of the fit
+    epoch: int  # the loop's epoch (a reset, model switch or preset starts another)
 
 
 @dataclass(frozen=True)
@@ -57,18 +67,20 @@ class GainView:
     """What the explorer shows; a new object whenever something changed (``version`` counts)."""
 
     version: int
+    epoch: int  # the loop's epoch the view belongs to
     model: str
     law: LawKind
     gains: Gains
     g_m_meaning: str  # what g_m means in this law, one line
-    map: GainMap | None  # decay rates over the g_b x g_m grid (1/s)
+    map: GainMap | None  # decay rates over the g_b x g_m grid (1/s), of this model and law
     current: Modes | None  # the poles at the gains in force
     locus_g_b: Locus | None  # poles as g_b sweeps at the current g_m
     locus_g_m: Locus | None  # poles as g_m sweeps at the current g_b
     paper: tuple[tuple[str, float, float], ...]  # (label, g_b, g_m) of the paper's gains for this law
     path_points: np.ndarray | None  # (K, 3) end-effector points (base frame, m) where authority is given
     authority: Authority | None  # predicted decay there at the current gains
-    measured: Measured | None
+    measured: Measured | None  # after a kick, at these gains, in this epoch
+    analysed: bool = True  # False: no linearisation for this model (a compensating arm's law), nothing predicted
 
     @property
     def predicted(self) -> float:
@@ -82,47 +94,74 @@ class GainExplorer:
         self._loop: LinearLoop | None = None
         self._loops: list[LinearLoop] | None = None
         self._key: tuple[str, LawKind, bytes] | None = None
-        self.kick_t = math.nan  # s, the last kick
+        self.kick_t = math.nan  # s, the last kick (nan: no fit due)
         self._next_fit = math.inf
-        self.view = GainView(0, "", "velocity", Gains(), "", None, None, None, None, (), None, None, None)
+        self.view = GainView(0, -1, "", "velocity", Gains(), "", None, None, None, None, (), None, None, None)
 
     # -- inputs from the loop --------------------------------------------------------------------
-    def context(self, model: str, law: LawKind, theta: np.ndarray, gains: Gains) -> None:
-        """Model, law or rest configuration changed: linearise anew (nothing is done if none changed)."""
+    def context(self, epoch: int, model: str, law: LawKind, theta: np.ndarray, gains: Gains) -> None:
+        """The loop's epoch, model, law, rest configuration or gains (may have) changed: linearise anew if
+        the model, law or configuration did, and forget a measurement of another epoch, model or law. One
+        published view: no reader sees the new model beside the old one's map."""
         theta = np.round(np.asarray(theta, dtype=float), 6)
         key = (model, law, theta.tobytes())
-        self._publish(model=model, law=law, gains=gains, g_m_meaning=G_M_MEANING.get(law, ""))
+        v = self.view
+        changes: dict[str, object] = {
+            "epoch": epoch,
+            "model": model,
+            "law": law,
+            "g_m_meaning": G_M_MEANING.get(law, ""),
+        }
+        if (epoch, model, law) != (v.epoch, v.model, v.law):
+            changes["measured"] = None
+            self._forget_kick()
         if key == self._key:
+            self._publish(**changes)
+            self.retune(gains)
             return
         self._key, self._loop, self._loops = key, None, None
         paper = tuple((p.label, p.g_b, p.g_m) for p in PAPER_GAINS.get((model, law), ()))
-        self._publish(map=None, current=None, locus_g_b=None, locus_g_m=None, paper=paper, authority=None)
-        if dual_by_name(model):  # its linearised loop would be law (15)'s on all joints, not the compensating law
+        if gains != v.gains:
+            changes["measured"] = None
+            self._forget_kick()
+        # a compensating arm's model: its linearised loop would be law (15)'s on all joints, not the compensating law
+        analysed = not dual_by_name(model)
+        self._publish(gains=gains, paper=paper, analysed=analysed, **changes, **_NOTHING_AT_KEY)
+        if not analysed:
             return
 
-        def job() -> tuple[LinearLoop, GainMap, tuple[Modes, Locus, Locus]]:
+        def job() -> tuple[LinearLoop, GainMap, tuple[Modes, Locus, Locus], Gains]:
             loop, grid = jobs.call("loop_and_map", model, law, theta)
-            return loop, grid, _at(loop, gains)
+            return loop, grid, _at(loop, gains), gains
 
         self.worker.submit("loop", key, job)
 
     def retune(self, gains: Gains) -> None:
-        self._publish(gains=gains)
+        """New gains: what was predicted or measured at the old ones goes until it is computed anew."""
+        if gains == self.view.gains:
+            return
+        self._forget_kick()
+        self._publish(gains=gains, measured=None, current=None, locus_g_b=None, locus_g_m=None, authority=None)
+        self._submit_at(gains)
+
+    def _submit_at(self, gains: Gains) -> None:
         loop, loops = self._loop, self._loops
         if loop is not None:
             self.worker.submit("at", (self._key, gains), lambda: _at(loop, gains))
         if loops is not None:
             self.worker.submit("authority", (self._key, gains), lambda: authority(loops, gains.g_b, gains.g_m))
 
-    def along(self, thetas: np.ndarray, ee: np.ndarray) -> None:
-        """The configurations (K, n) and end-effector points (K, 3) of the current path or set."""
-        if self._key is None or len(thetas) == 0:
+    def along(self, model: str, thetas: np.ndarray, ee: np.ndarray) -> None:
+        """The configurations (K, n) and end-effector points (K, 3) of model ``model``'s current path or set
+        (nothing if the explorer is on another model: the geometry of a model just left)."""
+        if self._key is None or self._key[0] != model or len(thetas) == 0:
             return
         pick = np.unique(np.linspace(0, len(thetas) - 1, min(AUTHORITY_POINTS, len(thetas))).astype(int))
         thetas, points = np.asarray(thetas, dtype=float)[pick], np.asarray(ee, dtype=float)[pick]
         key = self._key
-        model, law, _ = key
+        _, law, _ = key
         gains = self.view.gains
+        self._loops = None
         self._publish(path_points=points, authority=None)
 
         def job() -> tuple[list[LinearLoop], Authority] | None:
@@ -133,11 +172,24 @@ class GainExplorer:
                 loops += jobs.call("linear_loops", model, law, thetas[start : start + AUTHORITY_CHUNK])
             return loops, authority(loops, gains.g_b, gains.g_m)
 
-        self.worker.submit("along", self._key, job)
+        self.worker.submit("along", key, job)
 
-    def kicked(self, t: float) -> None:
-        self.kick_t, self._next_fit = t, t + FIT_FIRST_S
+    def kicked(self, t: float, suppress: bool) -> None:
+        """A kick at ``t``: fit its decay from FIT_FIRST_S on, if the operated run suppresses (the
+        prediction is of the suppressing law; without suppression there is nothing to compare)."""
+        self._forget_kick()
+        if suppress:
+            self.kick_t, self._next_fit = t, t + FIT_FIRST_S
         self._publish(measured=None)
+
+    def forget_measurement(self) -> None:
+        """Something the measurement depends on changed (suppression switched): no fit of this kick."""
+        self._forget_kick()
+        if self.view.measured is not None:
+            self._publish(measured=None)
+
+    def _forget_kick(self) -> None:
+        self.kick_t, self._next_fit = math.nan, math.inf
 
     def fit_due(self, t: float) -> bool:
         return t >= self._next_fit
@@ -152,12 +204,15 @@ class GainExplorer:
             fit = fit_decay(times, x_b, start=self.kick_t)
         except ValueError:
             return  # too few swings yet
-        self._publish(measured=Measured(fit.rate, self.kick_t, float(times[-1] - self.kick_t)))
+        v = self.view
+        seconds = float(times[-1] - self.kick_t)
+        self._publish(measured=Measured(fit.rate, self.kick_t, seconds, v.model, v.law, v.gains, v.epoch))
 
     # -- results -----------------------------------------------------------------------------------
     def collect(self) -> bool:
-        """Take finished results; True if the view changed."""
+        """Take finished results of the current model, law, configuration and gains; True if the view changed."""
         changed = False
+        gains = self.view.gains
         for res in self.worker.collect():
             if res.error is not None:
                 continue  # an equilibrium that cannot be linearised: the view says nothing
@@ -166,14 +221,21 @@ class GainExplorer:
                 continue
             changed = True
             if res.kind == "loop":
-                self._loop, gain_map, at = res.value
-                self._publish(map=gain_map, **_at_fields(at))
-            elif res.kind == "at" and res.tag[1] == self.view.gains:
+                self._loop, gain_map, at, at_gains = res.value
+                if at_gains == gains:
+                    self._publish(map=gain_map, **_at_fields(at))
+                else:  # the gains changed while the loop was computed: its poles are the old gains'
+                    self._publish(map=gain_map)
+                    self._submit_at(gains)
+            elif res.kind == "at" and res.tag[1] == gains:
                 self._publish(**_at_fields(res.value))
             elif res.kind == "along" and res.value is not None:  # None: abandoned when it went stale
                 self._loops, found = res.value
-                self._publish(authority=found)
-            elif res.kind == "authority" and res.tag[1] == self.view.gains:
+                if (found.g_b, found.g_m) == (gains.g_b, gains.g_m):
+                    self._publish(authority=found)
+                else:
+                    self._submit_at(gains)
+            elif res.kind == "authority" and res.tag[1] == gains:
                 self._publish(authority=res.value)
         return changed
 
@@ -186,6 +248,10 @@ class GainExplorer:
 
     def _publish(self, **changes: object) -> None:
         self.view = replace(self.view, version=self.view.version + 1, **changes)  # type: ignore[arg-type]
+
+
+# What a new model, law or configuration leaves of the view until its loop is linearised again.
+_NOTHING_AT_KEY = dict(map=None, current=None, locus_g_b=None, locus_g_m=None, path_points=None, authority=None)
 
 
 def _at(loop: LinearLoop, gains: Gains) -> tuple[Modes, Locus, Locus]:

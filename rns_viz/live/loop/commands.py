@@ -21,7 +21,7 @@ from rns_viz.control import Gains, InvalidGain, LawKind
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.outputs.recorder import MAX_RECORD_S
 from rns_viz.live.teaching.lessons import LESSONS
-from rns_viz.params import check_model_key
+from rns_viz.params import check_model_key, missing_extra
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 LIVE_LAWS: tuple[LawKind, ...] = ("acceleration", "torque", "velocity")
@@ -31,6 +31,16 @@ MAX_UBAR_SPEED = 1e4  # 1/(kg m s)
 MAX_TARGET_SPEED = 100.0  # m/s
 REPLAY_SPEEDS = (0.1, 4.0)  # recorded seconds per wall second
 GAIN_NAMES = frozenset(f.name for f in fields(Gains))
+
+
+def _installed(model: str, what: str) -> None:
+    """Refuse ``what`` (a model or preset) whose bundled model needs an optional extra that is not installed,
+    naming the install command (before anything is queued: the running simulation goes on untouched)."""
+    extra = missing_extra(model)
+    if extra is not None:
+        raise ValueError(
+            f"{what} needs rns-viz's optional extra '{extra}', not installed: pip install 'rns-viz[{extra}]'"
+        )
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -238,6 +248,7 @@ class SwitchModel(Command):
 
     def __post_init__(self) -> None:
         check_model_key(self.model)
+        _installed(self.model, f"the model {self.model}")
 
 
 @dataclass(frozen=True)
@@ -260,6 +271,7 @@ class LoadPreset(Command):
     def __post_init__(self) -> None:
         if self.name not in LIVE_SCENARIOS:
             raise ValueError(f"unknown preset {self.name!r}; choose one of {', '.join(LIVE_SCENARIOS)}")
+        _installed(LIVE_SCENARIOS[self.name].model, f"the preset {self.name}")
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,8 @@ class Geometry:
         self.reach_points = region.points
         self.reach_note = region.note
 
-    def overlays(self, model: str) -> Overlays:
+    def overlays(self, model: str, epoch: int) -> Overlays:
+        """What model ``model`` shows in the loop's ``epoch`` (the overlays say so: readers check)."""
         self.version += 1
         family = self.background.families.get(model)
-        return Overlays(family, self.current_path, self.reach_points, self.version, self.reach_note)
+        return Overlays(family, self.current_path, self.reach_points, self.version, self.reach_note, model, epoch)

@@ -31,6 +31,7 @@ from rns_viz.live.runs.kicks import kick_pulse
 from rns_viz.live.runs.run_pair import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.teaching.lesson_run import OBSERVE_EVERY, LessonRun, run_view
 from rns_viz.model import FsmsModel
+from rns_viz.params import model_source
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
@@ -81,9 +82,9 @@ class LiveState:
         self._new_operator(theta0)
         self.settings = replace(self.settings, preset=None)
         self._restart_bookkeeping()
-        op = self.operator
+        self._explore(theta0)  # before any geometry is taken: the explorer is on this model from here on
         table = self.geometry.default_tables.get(name) if theta is None else None
-        if table is not None and op is not None and op.accept_table(table, self.tol):
+        if table is not None and self.operator is not None and self.operator.accept_table(table, self.tol):
             self._took_table(table, default=True)
         else:
             self._request_geometry(theta0, default=True)
@@ -100,7 +101,10 @@ class LiveState:
         self.runs.install(self._choice(), op.joint, op.law_task(self.settings.law), op.joint_move is not None)
 
     def _restart_bookkeeping(self) -> None:
+        """A new epoch (reset, model switch, preset, selection); a lesson goes on only on its own model."""
         self.epoch += 1
+        if self.lesson is not None and model_source(self.model.name) != self.lesson.model:
+            self.lesson = None
         self.settings_version += 1
         self.target_version += 1
         self.paused, self.diverged = False, None
@@ -131,13 +135,8 @@ class LiveState:
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
-        self.settings = replace(
-            Settings.defaults(self.model.name, st.shadow, st.speed),
-            law=choice.kind,
-            gains=choice.gains,
-            suppress=choice.suppress,
-            preset=name,
-        )
+        defaults = Settings.defaults(self.model.name, st.shadow, st.speed)
+        self.settings = replace(defaults, law=choice.kind, gains=choice.gains, suppress=choice.suppress, preset=name)
         self._restart_bookkeeping()
         self.paused = self._preset_paused
         self._request_geometry(runs.theta)
@@ -149,11 +148,11 @@ class LiveState:
         self._explore(theta)
 
     def _explore(self, theta: np.ndarray) -> None:
-        self.explorer.context(self.model.name, self.settings.law, theta, self.settings.gains)
+        self.explorer.context(self.epoch, self.model.name, self.settings.law, theta, self.settings.gains)
 
     def _took_table(self, table: PathTable, default: bool) -> None:
         self.geometry.took_table(self.model.name, table, default)
-        self.explorer.along(table.theta, table.ee)
+        self.explorer.along(self.model.name, table.theta, table.ee)
 
     def notify(self, title: str, body: str, client: int | None = None, level: Level = "info") -> None:
         self.notices.append(Notice(title, body, client, level))
@@ -204,12 +203,13 @@ class LiveState:
                 duration = defaults_for(st.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m, direction))
                 self.kicks_sent += 1
-                self.explorer.kicked(self.runs.t)
+                self.explorer.kicked(self.runs.t, st.suppress)
             case c.SetSuppression(on=on):
                 self.runs.set_suppression(on)
                 if on != st.suppress:  # the runs swap roles: both, and the plots, restart from here
                     self.runs.resync_shadow()
                     self.outputs.plots.clear()
+                    self.explorer.forget_measurement()
                 self.settings = replace(st, suppress=on)
             case c.SetLaw(law=law):
                 refuse_other_laws(self.model, law)
@@ -383,13 +383,13 @@ class LiveState:
                     if self.operator is not None and not self.operator.on_path:
                         self.operator.reach = region
                     self.geometry.took_reach(region)
-                    self.explorer.along(region.thetas, region.points)
+                    self.explorer.along(self.model.name, region.thetas, region.points)
                     self._overlays_changed()
         self.explorer.collect()
 
     # ================================================================ outputs
     def _overlays_changed(self) -> None:
-        self.overlays = self.geometry.overlays(self.model.name)
+        self.overlays = self.geometry.overlays(self.model.name, self.epoch)
 
     def publish(self, realtime: bool) -> Snapshot:
         versions = (self.epoch, self.settings_version, self.target_version, self.geometry.version)

@@ -5,12 +5,23 @@ pool). Clients are known by their integer ids. Without a password the first clie
 operates while nobody does, and the lock passes to the longest-connected client when the
 operator leaves. With a password only clients that gave it (:meth:`OperatorLock.authenticate`
 or :meth:`OperatorLock.take` with the password) can hold the lock.
+
+A reload is a new client: the page's connection closes and a new one opens. So that reloading the
+operator's page keeps control, a client may be identified with its *browser* (a random token the page
+keeps, :meth:`OperatorLock.identify`): when the operator leaves, another client of the same browser (a
+reload that arrived first, a second tab) operates at once; otherwise the lock is kept for that browser
+for RELOAD_GRACE_S and passes on (:meth:`OperatorLock.expire`) if no page of it comes back. A browser that
+gave the password is known by it afterwards too.
 """
 
 from __future__ import annotations
 
 import hmac
 import threading
+import time
+from collections.abc import Callable
+
+RELOAD_GRACE_S = 10.0  # wall s: how long a departed operator's browser may take to come back (a reload)
 
 
 class LockRefused(ValueError):
@@ -18,16 +29,24 @@ class LockRefused(ValueError):
 
 
 class OperatorLock:
-    def __init__(self, password: str | None = None) -> None:
+    def __init__(self, password: str | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         self.password = password
+        self._clock = clock
         self._lock = threading.Lock()
         self._clients: list[int] = []  # in order of arrival
         self._authed: set[int] = set()
+        self._browser: dict[int, str] = {}  # client -> the token of its browser
+        self._authed_browsers: set[str] = set()
+        self._kept: tuple[str, float] | None = None  # (browser, until when): the lock kept for a reloading page
         self.operator: int | None = None
         self.version = 0  # bumps whenever the operator or the set of clients changes
 
     def _eligible(self, client: int) -> bool:
-        return self.password is None or client in self._authed
+        return self.password is None or client in self._authed or self._browser.get(client) in self._authed_browsers
+
+    def _keeping(self) -> bool:
+        """The lock is kept for a reloading operator's browser (and the grace has not run out)."""
+        return self._kept is not None and self._clock() <= self._kept[1]
 
     def _set(self, operator: int | None) -> None:
         self.operator = operator
@@ -39,10 +58,36 @@ class OperatorLock:
             if client not in self._clients:
                 self._clients.append(client)
             self.version += 1
-            if self.operator is None and self._eligible(client):
+            if self.operator is None and not self._keeping() and self._eligible(client):
                 self._set(client)
                 return True
             return False
+
+    def identify(self, client: int, browser: str) -> bool:
+        """``client`` runs in the browser of token ``browser``; True if it became the operator (its browser's
+        page operated and left within the grace: a reload)."""
+        with self._lock:
+            if client not in self._clients:
+                return False
+            self._browser[client] = browser
+            if client in self._authed:
+                self._authed_browsers.add(browser)
+            self.version += 1
+            if self._keeping() and self._kept is not None and self._kept[0] == browser:
+                self._kept = None
+                self._set(client)
+                return True
+            return False
+
+    def expire(self) -> int | None:
+        """Pass a kept lock on once its grace ran out; returns the new operator (None if nothing changed)."""
+        with self._lock:
+            if self._kept is None or self._keeping():
+                return None
+            self._kept = None
+            heir = next((c for c in self._clients if self._eligible(c)), None)
+            self._set(heir)
+            return heir
 
     def disconnect(self, client: int) -> int | None:
         """Forget ``client``; if it operated, the lock passes to the longest-connected eligible client.
@@ -52,8 +97,17 @@ class OperatorLock:
             if client in self._clients:
                 self._clients.remove(client)
             self._authed.discard(client)
+            browser = self._browser.pop(client, None)
             self.version += 1
             if self.operator != client:
+                return None
+            same = [c for c in self._clients if browser is not None and self._browser.get(c) == browser]
+            if same:  # its browser is still here (the reloaded page came first, or another tab): it goes on
+                self._set(same[-1])
+                return same[-1]
+            if browser is not None:  # perhaps a reload: kept for the browser a while (expire passes it on)
+                self._kept = (browser, self._clock() + RELOAD_GRACE_S)
+                self._set(None)
                 return None
             heir = next((c for c in self._clients if self._eligible(c)), None)
             self._set(heir)
@@ -65,7 +119,9 @@ class OperatorLock:
             if self.password is not None and not hmac.compare_digest(str(password), self.password):
                 return False
             self._authed.add(client)
-            if self.operator is None and client in self._clients:
+            if client in self._browser:
+                self._authed_browsers.add(self._browser[client])
+            if self.operator is None and not self._keeping() and client in self._clients:
                 self._set(client)
             return True
 
@@ -78,6 +134,7 @@ class OperatorLock:
                 raise LockRefused("that client is not connected")
             if not self._eligible(client):
                 raise LockRefused("enter the session password to take control")
+            self._kept = None
             if self.operator != client:
                 self._set(client)
 
@@ -86,6 +143,15 @@ class OperatorLock:
         with self._lock:
             if self.operator == client:
                 self._set(None)
+
+    def may_operate(self, client: int) -> bool:
+        """``client`` may hold the lock (no password is set, or it or its browser gave it)."""
+        with self._lock:
+            return self._eligible(client)
+
+    def browser(self, client: int) -> str | None:
+        """The token of ``client``'s browser, once identified."""
+        return self._browser.get(client)
 
     def is_operator(self, client: int) -> bool:
         return self.operator == client
@@ -99,6 +165,8 @@ class OperatorLock:
         operator = self.operator
         if operator == client:
             return "You are operating"
+        if operator is None and self._keeping():
+            return "Watching — the operator's page left; control is kept a few seconds in case it is reloading"
         if operator is None:
             return "Watching — nobody is operating"
         return f"Watching — client {operator} is operating"

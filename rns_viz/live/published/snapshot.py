@@ -151,3 +151,5 @@ class Overlays:
     reach: np.ndarray | None  # reactionless reachable end-effector points (multi-D RNS)
     version: int
     reach_note: str = ""  # the Lie-bracket test where the reachable set was explored from, in words
+    model: str = ""  # the model key they belong to ...
+    epoch: int = -1  # ... and the loop's epoch (the current path and reachable set are of this run)

@@ -6,6 +6,7 @@ decides whose inputs count. The server itself (client ``None``) may always opera
 
 from __future__ import annotations
 
+import secrets
 from contextlib import suppress
 
 import viser
@@ -15,6 +16,8 @@ from rns_viz.viz.clients.operator_panel import OperatorPanels
 
 NOTICE_COLOURS = {"info": "blue", "warning": "yellow", "error": "red"}
 NOTICE_SECONDS = 8.0  # a notification closes itself after this long
+BROWSER_KEY = "rns_viz_browser"  # localStorage key of the page's browser token (a reload keeps it)
+BROWSER_ASK_S = 30.0  # s: how long a page may take to answer (it answers after the scene it is sent first)
 
 
 class Connections:
@@ -62,10 +65,11 @@ class Connections:
         return len(self.server.get_clients())
 
     def client_joined(self, client: viser.ClientHandle) -> None:
-        """Give the newcomer its operator panel, and the password modal if the session has one."""
+        """Give the newcomer its operator panel."""
         self.panels.add(client)
-        if self.password is None:
-            return
+
+    def _ask_password(self, client: viser.ClientHandle) -> None:
+        """The password modal, for a page whose browser has not given the password yet."""
         with client.gui.add_modal("rns_viz: password") as modal:
             client.gui.add_markdown("Enter the password to operate this session; without it you can only watch.")
             text = client.gui.add_text("Password", "")
@@ -82,6 +86,24 @@ class Connections:
         @watch.on_click
         def _(_: viser.GuiEvent) -> None:
             modal.close()
+
+    def identify_browser(self, client: viser.ClientHandle) -> None:
+        """Ask the page for its browser's token (made and stored on its first visit) and tell the operator
+        lock: a reloaded operator's page gets control back, a browser that gave the password is not asked
+        again. Blocks this callback thread for one round trip; a page that does not answer (or has no
+        storage) stays unidentified."""
+        try:
+            token = client.local_storage.get_item(BROWSER_KEY, timeout=BROWSER_ASK_S)
+            if not (isinstance(token, str) and 16 <= len(token) <= 64 and token.isascii()):
+                token = secrets.token_urlsafe(24)  # 32 characters
+                client.local_storage.set_item(BROWSER_KEY, token)
+        except (RuntimeError, TimeoutError):
+            token = None
+        if token is not None:
+            self.panels.identified(client.client_id, token)
+        if self.password is not None and not self.lock.may_operate(client.client_id):
+            with suppress(Exception):  # the page may have gone meanwhile
+                self._ask_password(client)
 
     def client_left(self, client_id: int) -> None:
         """Forget a client; the lock passes control on if it was operating."""

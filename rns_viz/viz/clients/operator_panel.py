@@ -3,7 +3,8 @@
 Every connected browser sees the same simulation; the :class:`~rns_viz.live.operator.operator_lock.OperatorLock`
 decides whose inputs count. Each client gets its own small panel (``client.gui``) with its status
 line ("You are operating" / "Watching — client 3 is operating"), a password field when the
-session has one, and the two buttons. The render thread calls :meth:`OperatorPanels.refresh`.
+session has one, and the two buttons. The render thread calls :meth:`OperatorPanels.refresh`. Whoever
+loses control is told why (another client took it); whoever gets it is told too.
 """
 
 from __future__ import annotations
@@ -59,6 +60,11 @@ class OperatorPanels:
             self._panels[client.client_id] = panel
         self._shown_version = -1
 
+    def panel(self, client_id: int) -> ClientPanel | None:
+        """The panel of a connected client (its handles)."""
+        with self._guard:
+            return self._panels.get(client_id)
+
     def remove(self, client_id: int) -> int | None:
         """Forget a client that left; returns the new operator if the lock passed on."""
         with self._guard:
@@ -66,27 +72,42 @@ class OperatorPanels:
         was = self.lock.operator
         heir = self.lock.disconnect(client_id)
         if was == client_id and heir is not None:
-            with self._guard:
-                panel = self._panels.get(heir)
-            if panel is not None:
-                self.notify(panel.client, "You are operating", f"Client {client_id} left; you have control.", "info")
+            self._tell(heir, "You are operating", f"Client {client_id} left; you have control.")
         self._shown_version = -1
         return heir
 
     def _take(self, panel: ClientPanel) -> None:
         cid = panel.client.client_id
+        was = self.lock.operator
         try:
             self.lock.take(cid, None if panel.password is None else panel.password.value)
         except LockRefused as exc:
             self.notify(panel.client, "Control not taken", str(exc), "warning")
+        if was is not None and was != cid and self.lock.is_operator(cid):
+            self._tell(was, "Control taken", f"Client {cid} took control. Press 'Take control' to operate again.")
         self.refresh()
+
+    def identified(self, client_id: int, browser: str) -> None:
+        """The client's browser is known (its page's token): a reloaded operator's page operates again."""
+        if self.lock.identify(client_id, browser):
+            self._tell(client_id, "You are operating", "Your page reloaded; you still have control.")
+        self._shown_version = -1
+
+    def _tell(self, client_id: int, title: str, body: str) -> None:
+        panel = self.panel(client_id)
+        if panel is not None:
+            self.notify(panel.client, title, body, "info")
 
     def _release(self, panel: ClientPanel) -> None:
         self.lock.release(panel.client.client_id)
         self.refresh()
 
     def refresh(self) -> None:
-        """Show every client its status (cheap when nothing changed)."""
+        """Pass on a lock kept for a reloading page that did not come back; show every client its status
+        (cheap when nothing changed)."""
+        heir = self.lock.expire()
+        if heir is not None:
+            self._tell(heir, "You are operating", "The operator's page did not come back; you have control.")
         version = self.lock.version
         if version == self._shown_version:
             return

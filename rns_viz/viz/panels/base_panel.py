@@ -150,8 +150,11 @@ class BasePanel:
             self.overlay_version = overlays.version
             text = f"**Reachable set** ({len(overlays.reach)} points drawn). " if overlays.reach is not None else ""
             self.involution.content = text + overlays.reach_note
-        if version == self.plot_version or len(arrays["t"]) < 2:
+        if version == self.plot_version:
             return
         self.plot_version = version
+        if len(arrays["t"]) < 2:  # a restarted run: the last one's curves go
+            self.plot.data = tuple(np.zeros(2) for _ in range(BASE_COORDINATES + 1))
+            return
         columns = [np.nan_to_num(arrays[f"xb_{i + 1}"]) for i in range(BASE_COORDINATES)]
         self.plot.data = (arrays["t"], *columns)

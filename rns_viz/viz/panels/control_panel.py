@@ -2,8 +2,9 @@
 
 Layout, top to bottom (kick, presets and plots fit one 900 px screen): a status line; *Operate*
 (kick, suppression, run controls); *Paper presets*; *Live plots*; *Readouts*; *Reactionless path*
-(TREP) or *Target* (planar 3R); *Control law and gains*; *Model and view*; *Log*.
-Labels carry units; hints explain the symbols. Model-specific elements are shown or hidden by the app.
+(a 1-D reaction null space) or *Target* (otherwise); *Control law and gains*; *Model and view*; *Log*.
+Labels carry units; hints explain the symbols. Model-specific elements are shown or hidden by the app,
+and their words set per model (rns_viz.viz.panels.model_words).
 """
 
 from __future__ import annotations
@@ -54,18 +55,32 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
         0.0,
         2000.0,
         1.0,
-        "How strongly the hand is pulled to the target (1/s²), Eq. (24) (planar 3R).",
+        "How strongly the hand is pulled to the target (1/s²), Eq. (24) (end-effector tracking).",
     ),
-    ("G_d", "G_d (1/s)", 0.0, 500.0, 1.0, "How much the hand's motion is damped (1/s), Eq. (24) (planar 3R)."),
+    (
+        "G_d",
+        "G_d (1/s)",
+        0.0,
+        500.0,
+        1.0,
+        "How much the hand's motion is damped (1/s), Eq. (24) (end-effector tracking).",
+    ),
     (
         "k_p",
         "k_p (1/s²)",
         0.0,
         2000.0,
         1.0,
-        "How stiffly the joints follow the path's reference (1/s²), laws (15)/(16) (TREP).",
+        "How stiffly the joints follow the path's reference (1/s²), laws (15)/(16) (along a reactionless path).",
     ),
-    ("k_d", "k_d (1/s)", 0.0, 200.0, 0.5, "How much the joints' following is damped (1/s), laws (15)/(16) (TREP)."),
+    (
+        "k_d",
+        "k_d (1/s)",
+        0.0,
+        200.0,
+        0.5,
+        "How much the joints' following is damped (1/s), laws (15)/(16) (along a reactionless path).",
+    ),
 )
 
 
@@ -92,6 +107,7 @@ class GuiElements:
     point_to_point: viser.GuiButtonHandle
     ubar_speed: viser.GuiSliderHandle
     target_folder: viser.GuiFolderHandle
+    target_text: viser.GuiMarkdownHandle
     target_speed: viser.GuiSliderHandle
     law: viser.GuiDropdownHandle
     gains: dict[str, viser.GuiSliderHandle]
@@ -143,8 +159,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             max=defaults_for(model).kick_range_N,
             step=0.1,
             initial_value=defaults_for(model).kick_peak_N,
-            hint="Peak of the half-sine force pulse on the base (0.1 s for TREP, 0.2 s for the 3R); on a "
-            "spatial base, along the direction chosen under Base coordinates (N m on a rotation).",
+            hint="Peak of the half-sine force pulse on the base (N); the app says more per model.",
         )
         suppression = gui.add_checkbox(
             "Vibration suppression",
@@ -178,7 +193,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         plots = LivePlots(gui)
     with gui.add_folder("Readouts"):
         readouts = gui.add_html("")
-    with gui.add_folder("Reactionless path (TREP)") as path_folder:
+    with gui.add_folder("Reactionless path") as path_folder:
         gui.add_markdown(
             "Drag the handle labelled **drag me** in the scene: the end effector moves along its current "
             "reactionless path (red) to the point nearest the handle. Or scrub the path position."
@@ -222,13 +237,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="How fast the arm moves along the path, the paper's ū in 1/(kg·m·s) (Fig. 12 uses 30); "
             "the line above turns it into joint speeds.",
         )
-    with gui.add_folder("Target (planar 3R, TREP + compensator)") as target_folder:
-        gui.add_markdown(
-            "Drag the handle labelled **drag me** (x and y only). Planar 3R: the arm follows with "
-            "reactionless end-effector control, Eq. (24); targets outside the reactionless reachable set "
-            "(lilac dots) are clamped to its nearest point. TREP + compensator: the task arm follows "
-            "anywhere in its workspace and the second arm cancels its reaction on the beam."
-        )
+    with gui.add_folder("Target") as target_folder:
+        target_text = gui.add_markdown("")  # how the handle works for the model served (model_words)
         target_speed = gui.add_slider(
             "Target speed (m/s)",
             min=0.05,
@@ -303,6 +313,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         point_to_point=point_to_point,
         ubar_speed=ubar_speed,
         target_folder=target_folder,
+        target_text=target_text,
         target_speed=target_speed,
         law=law,
         gains=gains,

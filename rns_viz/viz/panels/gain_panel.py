@@ -22,6 +22,7 @@ from rns_viz.live.loop.session import Session
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.control_panel import GAIN_SLIDERS, GuiElements
 from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.panels.model_menu import label_of
 from rns_viz.viz.scene.gain_scene import LN10, GainScene, Quantity
 from rns_viz.viz.scene.style import SceneStyle
 
@@ -114,6 +115,7 @@ class GainExplorerView:
         self.clicks_applied = 0
         self._next_check = 0.0
         self._drawn: dict[str, object] = {}
+        self._loci_of: tuple[str, str] | None = None  # (model, law) of the root loci drawn
         self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:
@@ -124,14 +126,16 @@ class GainExplorerView:
         self._drawn = {}
 
     # -- per frame -------------------------------------------------------------------------------
-    def frame(self) -> None:
+    def frame(self, model: str) -> None:
+        """Draw the session's gain view if it changed and is of ``model``, the model whose scene is built
+        (a view of the next model waits for its scene)."""
         now = time.perf_counter()
         if now < self._next_check:
             return
         self._next_check = now + CHECK_S
         view = self.session.gain_view()
         quantity = QUANTITIES.get(self.controls.good(self.quantity), "base")
-        if self.scene is None or (view.version == self._version and quantity == self._quantity):
+        if self.scene is None or view.model != model or (view.version == self._version and quantity == self._quantity):
             return
         map_changed = view.map is not self.scene.gain_map or quantity != self._quantity
         self._version, self._quantity = view.version, quantity
@@ -140,7 +144,11 @@ class GainExplorerView:
         else:
             self.scene.show_now(view)
         drawn = self._drawn  # send only what changed: the parts of a view are new objects when they change
-        if map_changed or not _same((view.authority, view.path_points), drawn.get("authority")):
+        last = drawn.get("authority")
+        # new gains: the path keeps its colours the few ms until the authority at them arrives (no blinking
+        # while a slider is dragged); a new path, model or map is drawn at once
+        recolouring = view.authority is None and isinstance(last, tuple) and last[1] is view.path_points
+        if map_changed or not (_same((view.authority, view.path_points), last) or recolouring):
             drawn["authority"] = (view.authority, view.path_points)
             self.scene.show_authority(view, self.on_path)
         self._show_text(view)
@@ -167,7 +175,16 @@ class GainExplorerView:
                 handle.content = text
 
     def _show_loci(self, view: GainView) -> None:
+        """The root loci of the view. While new ones are computed the plots keep the last ones of this model
+        and law (their titles name the gains they are at); another model's or law's are cleared."""
         reach = _reach(view)
+        if (view.model, view.law) != self._loci_of:
+            self._loci_of = (view.model, view.law)
+            for plot in (self.locus_b, self.locus_m):
+                plot.data = tuple(np.zeros(2) for _ in range(4))
+                plot.title = (
+                    "Root locus: being computed…" if view.analysed else "Root locus: not computed for this model"
+                )
         for plot, locus, other in ((self.locus_b, view.locus_g_b, "g_m"), (self.locus_m, view.locus_g_m, "g_b")):
             if locus is None:
                 continue
@@ -242,19 +259,26 @@ def _fmt_rate(rate: float) -> str:
 
 
 def predicted_text(view: GainView) -> str:
-    """One line: predicted base decay at the gains in force, and after a kick the measured one."""
+    """One line: predicted base decay at the gains in force, and after a kick the measured one, naming what
+    it measured (model, gains, kick); only a measurement of the view's model, law, gains and run is shown."""
     gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
-    pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+    if view.analysed:
+        pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+    else:
+        pred = f"**Base decay** at {gains}: not predicted for this model (no linearisation of its compensating law)"
     m = view.measured
-    if m is None:
-        return f"{pred}; *kick the base to measure it* (fit of the |x_b| peaks, 4–20 s after the kick)."
+    if m is None or (m.model, m.law, m.gains, m.epoch) != (view.model, view.law, view.gains, view.epoch):
+        return f"{pred}; *kick the base with suppression on to measure it* (fit of the |x_b| peaks, 4–20 s after)."
+    what = f"{label_of(m.model)}, g_b = {m.gains.g_b:.4g}, g_m = {m.gains.g_m:.4g} 1/s"
     fit = f"fit over {m.seconds:.1f} s after the kick at t = {m.since:.1f} s"
-    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({fit})."
+    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({what}, {fit})."
 
 
 def authority_text(view: GainView, on_path: bool) -> str:
-    """One line: the range of the predicted base decay rate along the path (TREP) or over the set (3R)."""
+    """One line: the range of the predicted base decay rate along the path (1-D RNS) or over the set."""
     where = "along the current reactionless path" if on_path else "over the reactionless-reachable set (dots)"
+    if not view.analysed:
+        return f"Authority {where}: not predicted for this model."
     auth = view.authority
     if auth is None or len(auth.base_decay_rate) == 0:
         return f"Authority {where}: being computed…"

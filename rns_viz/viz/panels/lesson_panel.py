@@ -1,5 +1,6 @@
 """The *Lessons* folder: the lesson in progress (title, equation, explanation, task, progress, ✓ when
-done), Previous / Next / Stop, and a chooser over every lesson of both models.
+done), Previous / Next / Stop, and a chooser over every lesson of every model, showing the lesson running
+or else the first lesson of the model served.
 
 The lessons and their checks live in :mod:`rns_viz.live.teaching.lessons`; this panel only starts and stops
 them through the session and shows ``snapshot().lesson``. Refreshed by the render thread at 5 Hz.
@@ -15,6 +16,7 @@ import viser
 from rns_viz.live.loop.session import Session
 from rns_viz.live.published.snapshot import LessonStatus, Snapshot
 from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.params import model_source
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.scene.view_toggles import ViewToggles
 
@@ -45,6 +47,13 @@ NO_LESSON = (
     "No lesson running. Pick one below and press **Start**, or press **Next** for lesson 1. Each lesson loads "
     "a state, gives you a task and tells you when the simulation shows it done."
 )
+
+
+def chooser_entry(status: LessonStatus | None, model: str) -> str:
+    """The chooser's entry: the lesson running, else lesson 1 of model ``model`` (a model key), else of the first
+    model with lessons."""
+    wanted = (status.model, status.number) if status is not None else (model_source(model), 1)
+    return next((k for k, v in CHOICES.items() if v == wanted), next(iter(CHOICES)))
 
 
 def lesson_markdown(status: LessonStatus | None) -> str:
@@ -80,7 +89,9 @@ class LessonPanel:
             )
             self.stop = gui.add_button("Stop lesson", icon=viser.Icon.PLAYER_STOP, hint="Leave the lesson mode.")
             self.chooser = gui.add_dropdown(
-                "Lesson", tuple(CHOICES), hint="Every lesson of both models; Start loads the chosen one."
+                "Lesson",
+                tuple(CHOICES),
+                hint="Every lesson of every model; Start loads the chosen one (and its model).",
             )
             self.start = gui.add_button("Start", icon=viser.Icon.PLAYER_PLAY, hint="Start the lesson chosen above.")
         self._wire(self.previous, lambda c: self._step(-1, c))
@@ -88,7 +99,7 @@ class LessonPanel:
         self._wire(self.stop, lambda c: session.stop_lesson(c))
         self._wire(self.start, self._start_chosen)
         self._shown = NO_LESSON
-        self._lesson: tuple[str, int] | None = None
+        self._for: tuple[tuple[str, int] | None, str] | None = None  # (lesson, model source) the chooser was set for
 
     def _wire(self, button: viser.GuiButtonHandle, act: Callable[[int | None], None]) -> None:
         @button.on_click
@@ -131,12 +142,14 @@ class LessonPanel:
             self.text.content = text
         status = snap.lesson
         shown = None if status is None else (status.model, status.number)
-        if shown != self._lesson:  # the chooser follows the lesson started (by any button or the CLI)
-            self._lesson = shown
-            name = next((k for k, v in CHOICES.items() if v == shown), None)
-            if name is not None and self.chooser.value != name:
+        now = (shown, model_source(snap.settings.model))
+        if now != self._for:  # the chooser follows the lesson started (by any button or the CLI) or the model
+            started = self._for is None or shown != self._for[0]
+            self._for = now
+            name = chooser_entry(status, snap.settings.model)
+            if self.chooser.value != name:
                 self.chooser.value = name
-            if shown is not None and self.view is not None and shown in LESSON_VIEWS:
+            if started and shown is not None and self.view is not None and shown in LESSON_VIEWS:
                 self.view.show_only(LESSON_VIEWS[shown])
         _set_disabled(self.previous, status is None or status.number <= 1)
         _set_disabled(self.next, status is not None and status.number >= status.count)

@@ -132,6 +132,7 @@ class LivePlots:
         )
         self.mode = "linear"
         self.runs = "suppression"  # what the two runs are: the app sets it per model (``sides``)
+        self.empty = True  # the charts show no run (as built, or cleared since)
         self.show_mode("linear")
 
     @property
@@ -178,7 +179,9 @@ class LivePlots:
         """Send the arrays (PLOT_SERIES of the session) to the shown charts; False if too few samples."""
         t = arrays["t"]
         if len(t) < 2 or not np.all(np.isfinite(t)):
+            self.clear()  # a run restarted (reset, model, preset): its predecessor's curves must not stay
             return False
+        self.empty = False
         xb_on, xb_off = on_off(arrays, "xb")
         L_on, L_off = on_off(arrays, "L")
         shown = self.charts[self.mode]
@@ -197,6 +200,15 @@ class LivePlots:
         if self.peaks.content != content:
             self.peaks.content = content
         return True
+
+    def clear(self) -> None:
+        """Empty every chart and the peaks table (once: nothing is sent while they are empty)."""
+        if self.empty:
+            return
+        self.empty = True
+        for chart in (self.error, *(c for sets in self.chart_sets.values() for s in sets.values() for c in s.values())):
+            chart.data = tuple(np.zeros(2) for _ in chart.data)
+        self.peaks.content = peaks_html(None, self.sides)
 
 
 def _symlog(limits: tuple[float, float]) -> viser.uplot.Scale:

@@ -52,15 +52,15 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
     ),
     (
         "reach",
-        "Reactionless-reachable region (3R)",
+        "Reactionless-reachable region",
         True,
-        "Lilac dots: where the 3R's hand can go without ever pushing the base. The region ends at fold "
-        "curves, where the arm can no longer move the hand outward without moving its centre of mass "
-        "along the spring (J-bar loses rank).",
+        "Lilac dots: where the hand can go without ever pushing the base (a reaction null space of two or "
+        "more dimensions). The region ends at fold curves, where the arm can no longer move the hand "
+        "outward without moving its centre of mass along the base's swing (J-bar loses rank).",
     ),
     (
         "rank",
-        "Rank loss of H_bm (TREP, 3R)",
+        "Rank loss of H_bm",
         False,
         "Amber poses (Sec. III-B, the fourth case). " + RANK_HINT,
     ),

@@ -38,7 +38,7 @@ from rns_viz.viz.scene.view_toggles import make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
 from rns_viz.viz.server.render import TARGET_HANDLE, Renderer
 
-IDLE_RESTART_S = 60.0  # s of simulated time: a session older than this restarts for its first visitor
+IDLE_RESTART_S = 60.0  # s of simulated time: a session nobody watched this long restarts for its first visitor
 
 
 class RnsApp:
@@ -75,6 +75,9 @@ class RnsApp:
         self.renderer.text_panels += [self.replay.refresh, self.rank_inset.refresh]
         # each page gets updates at the rate it can draw; told so under the status line when slowed
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
+        start = session.snapshot()
+        self._unwatched_since: tuple[int, float] | None = (start.epoch, start.t)  # (epoch, t) the last client left
+        self._visitors = threading.Lock()
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
@@ -132,18 +135,30 @@ class RnsApp:
         self.server.stop()
 
     def _client_joined(self, client: viser.ClientHandle) -> None:
-        """Register the client; the first visitor of an unwatched session that ran on for a while gets
-        it from the start (not "t = 4365 s" of a kick nobody saw)."""
+        """Register the client. The first visitor of a session nobody watched for over IDLE_RESTART_S of
+        simulated time gets it from the start (not "t = 4365 s" of a kick nobody saw); a reload (the page
+        back after a moment) keeps the simulation, its recording and, for the operator's page, control."""
         self.connections.client_joined(client)
         self.pace.client_joined(client)
-        if self.connections.client_count() == 1 and self.session.snapshot().t > IDLE_RESTART_S:
-            self.session.reset()
+        with self._visitors:
+            since, self._unwatched_since = self._unwatched_since, None
+            if since is not None:  # nobody watched since then (a reload's page arrives while the old one is here)
+                snap = self.session.snapshot()
+                unwatched = snap.t - since[1] if snap.epoch == since[0] else snap.t  # s of simulated time
+                if unwatched > IDLE_RESTART_S:
+                    self.session.reset()
+        self.connections.identify_browser(client)  # last: it waits for the page's answer
 
     def _client_left(self, client: viser.ClientHandle) -> None:
-        """End the client's drag while it still counts as the operator, then pass control on."""
+        """End the client's drag while it still counts as the operator, then pass control on (or keep it a
+        moment for the operator's reloading page); the last one to leave starts the unwatched time."""
         self.controls.client_left(client.client_id)
         self.connections.client_left(client.client_id)
         self.pace.client_left(client.client_id)
+        with self._visitors:
+            if self.connections.client_count() == 0:
+                snap = self.session.snapshot()
+                self._unwatched_since = (snap.epoch, snap.t)
 
 
 def start_app(

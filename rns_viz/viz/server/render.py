@@ -22,6 +22,7 @@ from rns_viz.live.operator.dual_arm import is_dual
 from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.laws import LAW_LABELS
+from rns_viz.live.teaching.rank_view import has_rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
@@ -29,9 +30,11 @@ from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_d
 from rns_viz.viz.panels.gain_panel import GainExplorerView
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
+from rns_viz.viz.panels.model_words import kick_hint, target_text
 from rns_viz.viz.panels.panel_text import readouts_html, status_html
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
+from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles
 
@@ -71,6 +74,7 @@ class Renderer:
         self.model_name = snap.settings.model
         self.explorer = GainExplorerView(server, session, gui, controls, connections)
         self._build_scene(snap)
+        self.names_drawn = node_names(server)  # every scene node name drawn so far (for rebuilds)
         self._seen = _Seen()
         self.sync_settings(snap)
         self._stop = threading.Event()
@@ -110,6 +114,10 @@ class Renderer:
         if self.base_panel is not None:
             self.base_panel.for_model(self.model)
         show_boom_presets(self.gui, snap.settings.model)
+        self.gui.target_text.content = target_text(self.model)
+        self.gui.kick_peak.hint = kick_hint(self.model)
+        if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
+            self.view.boxes["rank"].visible = has_rank_inset(self.model)
         self.server.scene.add_label(
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
@@ -128,6 +136,9 @@ class Renderer:
         loop) is done again from a reset scene at the next frame, not left half-built for good."""
         self.server.scene.reset()
         self._build_scene(snap)
+        built = node_names(self.server)
+        resend_poses(self.server, built & self.names_drawn)  # a page may still hold a namesake's pose
+        self.names_drawn |= built
         g, controls = self.gui, self.controls
         with controls.quiet():
             defaults = defaults_for(snap.settings.model)
@@ -173,7 +184,7 @@ class Renderer:
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
             self._draw_overlays()
-        self.explorer.frame()  # the gain map, loci and authority, when the gain view changed
+        self.explorer.frame(self.model_name)  # the gain map, loci and authority, when the gain view changed
         if self.controls.take_handle_home_request():
             seen.target_version = -1
         self._draw_target(snap)
@@ -236,6 +247,9 @@ class Renderer:
 
     def _draw_overlays(self) -> None:
         ov = self.session.overlays()
+        if ov.model != self.model_name:  # a switch published after this frame's snapshot: drawn once rebuilt
+            self._seen.overlay_version = -1
+            return
         curves = list(ov.family or [])
         if ov.current is not None:
             curves.append(ov.current)
