@@ -63,15 +63,18 @@ def map_rates(gain_map: GainMap, quantity: Quantity) -> np.ndarray:
 
 
 def map_image(gain_map: GainMap, quantity: Quantity) -> tuple[np.ndarray, tuple[float, float]]:
-    """RGB image (G*CELL_PIXELS, B*CELL_PIXELS, 3) of the map (g_m up, g_b right) and its colour scale."""
+    """RGB image (G*CELL_PIXELS, B*CELL_PIXELS, 3) of the map and its colour scale: column = g_b (left to
+    right), row = g_m (row 0 the lowest), as :class:`GainScene` shows it (g_b right, g_m up)."""
     rates = map_rates(gain_map, quantity)
     scale = colour_scale(rates, gain_map.stable)
     rgb = colours(rates, scale)  # (B, G, 3)
     rgb[~np.isfinite(rates)] = MISSING_RGB
     hatch = np.zeros((CELL_PIXELS, CELL_PIXELS), dtype=bool)
     hatch[np.add.outer(np.arange(CELL_PIXELS), np.arange(CELL_PIXELS)) % CELL_PIXELS == 0] = True
-    cells = np.repeat(np.repeat(rgb.transpose(1, 0, 2)[::-1], CELL_PIXELS, 0), CELL_PIXELS, 1)  # row 0 = top g_m
-    bad = np.repeat(np.repeat((~gain_map.stable).T[::-1], CELL_PIXELS, 0), CELL_PIXELS, 1)
+    # Row 0 is the lowest g_m: viser draws an image's row 0 at the plane's local -y (its client turns the
+    # plane by pi about x), and the map frame's +y is g_m up.
+    cells = np.repeat(np.repeat(rgb.transpose(1, 0, 2), CELL_PIXELS, 0), CELL_PIXELS, 1)
+    bad = np.repeat(np.repeat((~gain_map.stable).T, CELL_PIXELS, 0), CELL_PIXELS, 1)
     stripes = np.tile(hatch, (gain_map.g_m.size, gain_map.g_b.size))
     cells[bad] = UNSTABLE_RGB
     cells[bad & stripes] = UNSTABLE_HATCH
