@@ -126,6 +126,7 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
 # -- the drawn map against its numbers ---------------------------------------------------------------
 COLOUR_TOLERANCE = 12  # per RGB channel: the legend's numbers are rounded to 3 digits; the page draws exactly
 AGREEING_CELLS = 0.97  # of the cells read: the rest may sit under a mark drawn on the map
+PICTURE_WAIT_S = 20.0  # s: for the page to draw a new map's picture
 
 
 @pytest.fixture(params=["trep", "planar3r"], name="map_app")
@@ -159,16 +160,31 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
 
 
 def screen_cells(page: Page, scene: GainScene, gm: GainMap) -> np.ndarray:
-    """(B, G, 2) page pixels of the cells' centres, projected by the page's own camera."""
-    out = np.zeros((gm.g_b.size, gm.g_m.size, 2))
-    us = [axis_fraction(gm.g_b, g) for g in gm.g_b]
-    vs = [axis_fraction(gm.g_m, g) for g in gm.g_m]
-    for i, u in enumerate(us):
-        for j, v in enumerate(vs):
-            point = screen_point(page, ((u - 0.5) * scene.size, (v - 0.5) * scene.size, 0.0))
-            assert point is not None, "the page's camera or the map was not found"
-            out[i, j] = point
-    return out
+    """(B, G, 2) page pixels of the cells' centres, projected by the page's own camera (one call)."""
+    us = np.array([axis_fraction(gm.g_b, g) for g in gm.g_b])
+    vs = np.array([axis_fraction(gm.g_m, g) for g in gm.g_m])
+    u, v = np.meshgrid(us, vs, indexing="ij")
+    local = np.stack([(u - 0.5) * scene.size, (v - 0.5) * scene.size, np.zeros_like(u)], axis=-1)
+    pixels = page.evaluate(
+        """(points) => {
+            const m = window.__viserMutable;
+            const node = m?.nodeRefFromName?.["/gain_map"];
+            const camera = m?.camera;
+            const canvas = [...document.querySelectorAll("canvas")].sort(
+                (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
+            )[0];  // the scene's, not a plot's
+            if (!node || !camera || !canvas) return null;
+            node.updateWorldMatrix(true, false);
+            const r = canvas.getBoundingClientRect();
+            return points.map((p) => {
+                const v = node.localToWorld(new node.position.constructor(p[0], p[1], p[2])).project(camera);
+                return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+            });
+        }""",
+        local.reshape(-1, 3).tolist(),
+    )
+    assert pixels is not None, "the page's camera or the map was not found"
+    return np.asarray(pixels, dtype=float).reshape(gm.g_b.size, gm.g_m.size, 2)
 
 
 def read_pixels(page: Page, where: np.ndarray) -> np.ndarray:
@@ -179,32 +195,42 @@ def read_pixels(page: Page, where: np.ndarray) -> np.ndarray:
     return np.median(np.stack(around), axis=0)
 
 
+def agreeing(gm: GainMap, drawn: np.ndarray, want: np.ndarray) -> np.ndarray:
+    """(B, G) bool: each stable cell drawn in its legend colour, each unstable one hatched grey (any grey
+    between the hatching's two: 3 x 3 pixels may span a stripe)."""
+    lo, hi = min(UNSTABLE_RGB[0], UNSTABLE_HATCH[0]), max(UNSTABLE_RGB[0], UNSTABLE_HATCH[0])
+    grey = (np.ptp(drawn, axis=-1) <= COLOUR_TOLERANCE) & (drawn[..., 0] >= lo - COLOUR_TOLERANCE)
+    grey &= drawn[..., 0] <= hi + COLOUR_TOLERANCE
+    return np.where(gm.stable, np.abs(drawn - want).max(axis=-1) <= COLOUR_TOLERANCE, grey)
+
+
 def check_drawn_map(app: RnsApp, page: Page, quantity: str) -> tuple[int, int]:
     """The map drawn in the page agrees cell by cell with the legend's colour of each cell's rate; the
     cells of the highest and the lowest rate show the legend's two ends. Returns the fastest cell (i, j)."""
     ex = app.renderer.explorer
     scene = ex.scene
     assert scene is not None and scene.gain_map is not None
-    gm = scene.gain_map
-    rates = map_rates(gm, quantity)  # type: ignore[arg-type]
-    scale = legend_scale(scene.legend.text)
-    want = expected_colours(rates, scale)
-    cells = screen_cells(page, scene, gm)
-    spacing = np.linalg.norm(cells[1, 0] - cells[0, 0])
-    assert spacing >= 6.0, f"cells {spacing:.1f} px apart: too small to read one pixel block each"
     # The marks on the map (now, the paper's points, axis names) are hidden while its pixels are read.
     marks = [scene.now, *scene._ticks, *scene._paper]  # (what covers cells)
     for mark in marks:
         mark.visible = False  # type: ignore[attr-defined]
-    wait_for_frames(page, 10)
-    drawn = read_pixels(page, cells)
+    # The page loads a new map's PNG into a texture in its own time (seconds on a busy machine): read
+    # until the drawing agrees or PICTURE_WAIT_S has passed; a wrong picture never agrees.
+    deadline = time.monotonic() + PICTURE_WAIT_S
+    while True:
+        wait_for_frames(page, 10)
+        gm, scale = scene.gain_map, legend_scale(scene.legend.text)  # (the map of the pose now)
+        cells = screen_cells(page, scene, gm)  # (where the page's camera is now)
+        spacing = np.linalg.norm(cells[1, 0] - cells[0, 0])
+        assert spacing >= 6.0, f"cells {spacing:.1f} px apart: too small to read one pixel block each"
+        drawn = read_pixels(page, cells)
+        rates = map_rates(gm, quantity)  # type: ignore[arg-type]
+        want = expected_colours(rates, scale)
+        agree = agreeing(gm, drawn, want)
+        if agree.mean() >= AGREEING_CELLS or time.monotonic() > deadline:
+            break
     for mark in marks:
         mark.visible = True  # type: ignore[attr-defined]
-    # hatched grey: a grey between the two the hatching uses (3 x 3 pixels may span a stripe)
-    lo, hi = min(UNSTABLE_RGB[0], UNSTABLE_HATCH[0]), max(UNSTABLE_RGB[0], UNSTABLE_HATCH[0])
-    grey = (np.ptp(drawn, axis=-1) <= COLOUR_TOLERANCE) & (drawn[..., 0] >= lo - COLOUR_TOLERANCE)
-    grey &= drawn[..., 0] <= hi + COLOUR_TOLERANCE
-    agree = np.where(gm.stable, np.abs(drawn - want).max(axis=-1) <= COLOUR_TOLERANCE, grey)
     bad = tuple(np.argwhere(~agree)[0]) if not agree.all() else None
     assert agree.mean() >= AGREEING_CELLS, (
         f"{quantity}: only {agree.mean():.0%} of the drawn cells show their legend colour "
