@@ -13,7 +13,7 @@ import pytest
 from rns_viz.live.plots import PLOT_SERIES
 from rns_viz.live.session import Session
 from rns_viz.viz.app import IDLE_RESTART_S, start_app
-from rns_viz.viz.live_plots import on_off, peaks_html
+from rns_viz.viz.live_plots import LENGTH_UNITS, MOMENTUM_UNITS, display_unit, on_off, peaks_html
 from rns_viz.viz.units import si
 from tests.browser import wait_for_clients, wait_until
 from tests.protocol_client import ProtocolClient
@@ -26,6 +26,18 @@ def test_si_prefixes_and_zeros() -> None:
     assert si(-1.2e-42, "N", floor=1e-6) == "0 N"  # not "-1.2e-42 N"
     assert si(0.9997e-3, "m") == "1 mm"  # not "1e+03 µm"
     assert si(3.0, "N", sign=True) == "+3 N" and si(math.nan, "m") == "—"
+
+
+def test_display_units_suit_the_window() -> None:
+    """The unit a linear chart shows: its peak reads 1 to 1000 of it, kept from 0.5 to 2000 (no flapping)."""
+    assert display_unit(2e-10, LENGTH_UNITS, "mm") == "nm"  # below 1 nm: drawn as 0, in nm
+    assert display_unit(2e-7, LENGTH_UNITS, "mm") == "nm"  # 200 nm, not 0.0002 mm ("0" five times)
+    assert display_unit(2.5e-2, LENGTH_UNITS, "µm") == "mm"  # 25 mm, not 25,000 µm
+    assert display_unit(3.0, LENGTH_UNITS, "mm") == "m"
+    assert display_unit(1.5e-3, LENGTH_UNITS, "µm") == "µm"  # 1500 µm: kept (four digits)
+    assert display_unit(0.6e-6, LENGTH_UNITS, "µm") == "µm" and display_unit(0.4e-6, LENGTH_UNITS, "µm") == "nm"
+    assert display_unit(5e-9, MOMENTUM_UNITS, "mN·s") == "nN·s" and display_unit(30.0, MOMENTUM_UNITS, "mN·s") == "N·s"
+    assert display_unit(0.0, LENGTH_UNITS, "µm") == "µm" and display_unit(math.nan, LENGTH_UNITS, "mm") == "mm"
 
 
 def test_curves_are_coloured_by_suppression_sample_by_sample() -> None:
@@ -52,7 +64,7 @@ def test_chart_options_never_change_with_presets_models_and_suppression() -> Non
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         s, plots = app.session, app.gui.plots
-        charts = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values()] + [plots.error]
+        charts = plots.all_charts()
         before = [_options(c) for c in charts]
 
         def sent(what: str, step: Callable[[], object]) -> None:
@@ -146,13 +158,13 @@ def test_legend_and_caption_name_the_two_runs_of_the_model_served_and_of_its_rep
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         plots = app.gui.plots
-        shown = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values() if c.visible]
+        shown = [c for c in plots.all_charts() if c.visible and c is not plots.error]
         assert len(shown) == 2 and all(_legend(c) == ("suppression on", "suppression off") for c in shown)
         assert "suppression on" in plots.caption.content and "second arm" not in plots.caption.content
         app.session.switch_model("trep2")
         app.session.advance(0.01)
         wait_until(lambda: plots.runs == "compensation", 20.0, "the trep2 panel")
-        shown = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values() if c.visible]
+        shown = [c for c in plots.all_charts() if c.visible and c is not plots.error]
         assert len(shown) == 2 and all(_legend(c) == ("compensation on", "compensator held still") for c in shown)
         assert "held still" in plots.caption.content and "suppression on" not in plots.caption.content
         assert "compensating" in plots.peaks.content and "suppression on" not in plots.peaks.content

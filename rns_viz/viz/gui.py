@@ -84,7 +84,6 @@ class GuiElements:
     speed: viser.GuiDropdownHandle
     readouts: viser.GuiHtmlHandle
     plots: LivePlots
-    plot_error: viser.GuiUplotHandle
     path_folder: viser.GuiFolderHandle
     sigma: NumberField
     play_slow: viser.GuiButtonHandle
@@ -117,6 +116,11 @@ class GuiElements:
     @property
     def plot_L(self) -> viser.GuiUplotHandle:
         return self.plots.L
+
+    @property
+    def plot_error(self) -> viser.GuiUplotHandle:
+        """The end-effector error chart shown now (its unit suits the data)."""
+        return self.plots.error
 
 
 def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = None) -> GuiElements:
@@ -306,7 +310,6 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         speed=speed,
         readouts=readouts,
         plots=plots,
-        plot_error=plots.error,
         path_folder=path_folder,
         sigma=sigma,
         play_slow=play_slow,
