@@ -238,7 +238,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         gui.add_markdown(
             "Drag the handle labelled **drag me** (x and y only). Planar 3R: the arm follows with "
             "reactionless end-effector control, Eq. (24); targets outside the reactionless reachable set "
-            "(lilac dots) are clamped to its nearest point. TREP + compensator: the task arm follows "
+            "(the small lilac dots; the larger yellow-to-purple dots on it are the gain explorer's authority) "
+            "are clamped to its nearest point. TREP + compensator: the task arm follows "
             "anywhere in its workspace and the second arm cancels its reaction on the beam."
         )
         target_speed = NumberField(
