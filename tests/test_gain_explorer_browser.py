@@ -42,24 +42,27 @@ from tests.browser import (
 pytestmark = browser_marks
 
 
+PROJECT_JS = """(points) => {
+    const m = window.__viserMutable;
+    const node = m?.nodeRefFromName?.["/gain_map"];
+    const camera = m?.camera;
+    const canvas = [...document.querySelectorAll("canvas")].sort(
+        (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
+    )[0];  // the scene's, not a plot's
+    if (!node || !camera || !canvas) return null;
+    node.updateWorldMatrix(true, false);
+    const r = canvas.getBoundingClientRect();
+    return points.map((p) => {
+        const v = node.localToWorld(new node.position.constructor(p[0], p[1], p[2])).project(camera);
+        return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+    });
+}"""  # page pixels of points given in the map's frame, projected by the page's own camera
+
+
 def screen_point(page: Page, local: tuple[float, float, float]) -> tuple[float, float] | None:
     """Page pixel of a point given in the map's frame, projected by the page's own camera."""
-    return page.evaluate(
-        """(p) => {
-            const m = window.__viserMutable;
-            const node = m?.nodeRefFromName?.["/gain_map"];
-            const camera = m?.camera;
-            const canvas = [...document.querySelectorAll("canvas")].sort(
-                (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
-            )[0];  // the scene's, not a plot's
-            if (!node || !camera || !canvas) return null;
-            node.updateWorldMatrix(true, false);
-            const v = node.localToWorld(new node.position.constructor(p[0], p[1], p[2])).project(camera);
-            const r = canvas.getBoundingClientRect();
-            return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
-        }""",
-        list(local),
-    )
+    pixels = page.evaluate(PROJECT_JS, [list(local)])
+    return None if pixels is None else tuple(pixels[0])
 
 
 def test_gain_map_in_chromium(app: RnsApp) -> None:
@@ -129,7 +132,7 @@ AGREEING_CELLS = 0.97  # of the cells read: the rest may sit under a mark drawn 
 PICTURE_WAIT_S = 20.0  # s: for the page to draw a new map's picture
 
 
-@pytest.fixture(params=["trep", "planar3r"], name="map_app")
+@pytest.fixture(params=["trep", "planar3r", "boom7"], name="map_app")
 def each_model_map_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
     app = start_app(request.param, port=0, verbose=False)
     yield app
@@ -165,24 +168,7 @@ def screen_cells(page: Page, scene: GainScene, gm: GainMap) -> np.ndarray:
     vs = np.array([axis_fraction(gm.g_m, g) for g in gm.g_m])
     u, v = np.meshgrid(us, vs, indexing="ij")
     local = np.stack([(u - 0.5) * scene.size, (v - 0.5) * scene.size, np.zeros_like(u)], axis=-1)
-    pixels = page.evaluate(
-        """(points) => {
-            const m = window.__viserMutable;
-            const node = m?.nodeRefFromName?.["/gain_map"];
-            const camera = m?.camera;
-            const canvas = [...document.querySelectorAll("canvas")].sort(
-                (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
-            )[0];  // the scene's, not a plot's
-            if (!node || !camera || !canvas) return null;
-            node.updateWorldMatrix(true, false);
-            const r = canvas.getBoundingClientRect();
-            return points.map((p) => {
-                const v = node.localToWorld(new node.position.constructor(p[0], p[1], p[2])).project(camera);
-                return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
-            });
-        }""",
-        local.reshape(-1, 3).tolist(),
-    )
+    pixels = page.evaluate(PROJECT_JS, local.reshape(-1, 3).tolist())
     assert pixels is not None, "the page's camera or the map was not found"
     return np.asarray(pixels, dtype=float).reshape(gm.g_b.size, gm.g_m.size, 2)
 
@@ -204,9 +190,11 @@ def agreeing(gm: GainMap, drawn: np.ndarray, want: np.ndarray) -> np.ndarray:
     return np.where(gm.stable, np.abs(drawn - want).max(axis=-1) <= COLOUR_TOLERANCE, grey)
 
 
-def check_drawn_map(app: RnsApp, page: Page, quantity: str) -> tuple[int, int]:
+def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = False) -> tuple[int, int]:
     """The map drawn in the page agrees cell by cell with the legend's colour of each cell's rate; the
-    cells of the highest and the lowest rate show the legend's two ends. Returns the fastest cell (i, j)."""
+    cells of the highest and the lowest rate show the legend's two ends. ``hovered``: with the mouse on
+    the map, as when a person picks a cell (viser's hover outline once tinted the whole map yellow).
+    Returns the fastest cell (i, j)."""
     ex = app.renderer.explorer
     scene = ex.scene
     assert scene is not None and scene.gain_map is not None
@@ -216,6 +204,9 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str) -> tuple[int, int]:
         mark.visible = False  # type: ignore[attr-defined]
     # The page loads a new map's PNG into a texture in its own time (seconds on a busy machine): read
     # until the drawing agrees or PICTURE_WAIT_S has passed; a wrong picture never agrees.
+    centre = screen_point(page, (0.0, 0.0, 0.0))
+    assert centre is not None
+    page.mouse.move(*(centre if hovered else (5.0, 5.0)))
     deadline = time.monotonic() + PICTURE_WAIT_S
     while True:
         wait_for_frames(page, 10)
@@ -259,7 +250,8 @@ def applied_gains(app: RnsApp) -> tuple[float, float]:
 def test_the_drawn_map_agrees_with_its_numbers_legend_and_clicks(map_app: RnsApp) -> None:
     app = map_app
     ex = app.renderer.explorer
-    laws = ("velocity", "acceleration") if app.model_name == "trep" else ("velocity",)
+    laws = {"trep": ("velocity", "torque"), "planar3r": ("acceleration", "velocity"), "boom7": ("acceleration",)}
+    laws = laws[app.model_name]
     with browser_page(app.server, width=1280, height=800, draw=True) as page:
         for law in laws:
             if app.session.snapshot().settings.law != law:
@@ -287,6 +279,8 @@ def test_the_drawn_map_agrees_with_its_numbers_legend_and_clicks(map_app: RnsApp
                 wait_until(lambda s=sym, h=legend: h.text.startswith(s), 10.0, f"the {quantity} map")
                 wait_for_frames(page, 10)
                 i, j = check_drawn_map(app, page, quantity)
+                if quantity == "base":
+                    check_drawn_map(app, page, quantity, hovered=True)
             # A click on the fastest (arm) cell's drawn position applies that cell's gains.
             gm = scene.gain_map
             assert gm is not None
