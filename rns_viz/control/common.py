@@ -22,6 +22,9 @@ from rns_viz.rns import DampedInverse, damped_pinv, damped_row_pinv, project_ont
 LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
 
+MAX_GAIN = 1e6  # any gain, in its units: far beyond every stable setting of the bundled models
+
+
 class InvalidGain(ValueError):
     """A gain that is not a finite number in its allowed range."""
 
@@ -43,10 +46,8 @@ class Gains:
             value = getattr(self, f.name)
             if not isinstance(value, int | float) or isinstance(value, bool) or not math.isfinite(value):
                 raise InvalidGain(f"gain {f.name} must be a finite number, got {value!r}")
-            if value < 0:
-                raise InvalidGain(f"gain {f.name} must not be negative, got {value}")
-            if value > 1e6:
-                raise InvalidGain(f"gain {f.name} = {value} is beyond any stable setting (max 1e6)")
+            if not 0 <= value <= MAX_GAIN:  # (larger is beyond any stable setting)
+                raise InvalidGain(f"gain {f.name} must be from 0 to {MAX_GAIN:g}, got {value:g}")
         if self.servo_bandwidth <= 0:
             raise InvalidGain("servo_bandwidth must be positive")
 

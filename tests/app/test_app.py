@@ -148,7 +148,7 @@ def test_unreachable_3r_target_is_clamped_and_reported(planar_app: RnsApp, clien
 def test_scrubbing_trep_along_its_path_keeps_the_base_still(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     theta0 = s.snapshot().q[1:].copy()
-    client.set_value(uuid(trep_app.gui.sigma), 40.0)
+    client.set_value(uuid(trep_app.gui.sigma.slider), 40.0)
     queued(trep_app, "Scrub")
     s.advance(4.0)
     snap = s.snapshot()

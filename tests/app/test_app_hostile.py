@@ -20,6 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rns_viz.viz.panels.control_panel import GuiElements
+from rns_viz.viz.panels.number_field import NumberField
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
 from tests.support.browser import wait_for_clients, wait_until
 from tests.support.protocol_client import ProtocolClient, gui_uuid
@@ -42,13 +43,16 @@ positions = st.tuples(numbers, numbers, numbers)
 
 
 def controls(gui: GuiElements, app: RnsApp | None = None) -> list[Any]:
-    """Every input control of the panel, from the GuiElements fields (gain sliders included), and the base
-    panel's (kick direction, selection S; hidden for a 1-DOF base, but a client can still send to them)."""
+    """Every input control of the panel, from the GuiElements fields (each number field's slider and typed
+    box, gains included), and the base panel's (kick direction, selection S; hidden for a 1-DOF base, but a
+    client can still send to them)."""
     out: list[Any] = []
     for f in fields(gui):
         value = getattr(gui, f.name)
         for handle in value.values() if isinstance(value, dict) else [value]:
-            if isinstance(handle, INPUT_TYPES):
+            if isinstance(handle, NumberField):
+                out += [handle.slider, handle.box]
+            elif isinstance(handle, INPUT_TYPES):
                 out.append(handle)
     if app is not None:
         out += [app.base_panel.direction, *app.base_panel.boxes]
@@ -95,9 +99,11 @@ def assert_finite_everywhere(app: RnsApp) -> None:
     for plot in (g.plot_xb, g.plot_L, g.plot_error):  # what was sent to the browsers
         assert all(np.all(np.isfinite(np.asarray(a, dtype=float))) for a in plot.data)
     assert np.all(np.isfinite(app.handle.position))
-    for slider in controls(g):
-        if isinstance(slider, viser.GuiSliderHandle):
-            assert math.isfinite(app.good(slider)), slider.label
+    for f in fields(g):
+        value = getattr(g, f.name)
+        for field in value.values() if isinstance(value, dict) else [value]:
+            if isinstance(field, NumberField):
+                assert math.isfinite(app.good(field)) and math.isfinite(field.value), field.label
 
 
 actions = st.lists(

@@ -16,7 +16,7 @@ from tests.support.protocol_client import ProtocolClient
 
 @pytest.mark.parametrize("client", ["trep_app"], indirect=True)
 def test_invalid_gain_input_is_refused_and_the_old_value_kept(trep_app: RnsApp, client: ProtocolClient) -> None:
-    s, slider = trep_app.session, trep_app.gui.gains["g_b"]
+    s, slider = trep_app.session, trep_app.gui.gains["g_b"].slider  # (its track: dragged values)
     old = s.snapshot().settings.gains.g_b
     for told, bad in enumerate((float("nan"), -5.0, float("inf")), start=1):
         client.set_value(uuid(slider), bad)

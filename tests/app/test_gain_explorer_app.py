@@ -210,9 +210,17 @@ def test_map_image_marks_unstable_cells_and_clicks_map_to_cells(app: RnsApp) -> 
     image, scale = map_image(gm, "base")
     assert image.shape[:2] == (gm.g_m.size * 4, gm.g_b.size * 4)
     assert 0 < scale[0] < scale[1]
+    # Row 0 is the highest g_m (the image node is turned to show it at the top; the browser test reads
+    # the drawn pixels): cell (i, j) of grid point (g_b[i], g_m[j]) is at rows 4(G-1-j).., columns 4i...
+    G = gm.g_m.size
     i, j = np.argwhere(~gm.stable)[0]
-    cell = image[(gm.g_m.size - 1 - j) * 4 : (gm.g_m.size - j) * 4, i * 4 : (i + 1) * 4]
+    cell = image[(G - 1 - j) * 4 : (G - j) * 4, i * 4 : (i + 1) * 4]
     assert {tuple(p) for p in cell.reshape(-1, 3)} <= {(90, 90, 90), (200, 200, 200)}
+    rates = np.where(gm.stable, gm.base_decay_rate, np.nan)
+    for k in (np.nanargmax(rates), np.nanargmin(rates)):
+        i, j = np.unravel_index(k, rates.shape)
+        want = colours(gm.base_decay_rate[i, j], scale)
+        assert np.all(image[(G - 1 - j) * 4 : (G - j) * 4, i * 4 : (i + 1) * 4] == want)
     assert grid_point(gm, 0.0, 0.0) == (gm.g_b[0], gm.g_m[0])
     assert grid_point(gm, 1.0, 1.0) == (gm.g_b[-1], gm.g_m[-1])
     assert grid_point(gm, 1.01, 0.5) is None and grid_point(gm, float("nan"), 0.5) is None

@@ -23,7 +23,7 @@ def test_chart_options_never_change_with_presets_models_and_suppression() -> Non
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         s, plots = app.session, app.gui.plots
-        charts = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values()] + [plots.error]
+        charts = plots.all_charts()
         before = [_options(c) for c in charts]
 
         def sent(what: str, step: Callable[[], object]) -> None:
@@ -78,13 +78,13 @@ def test_legend_and_caption_name_the_two_runs_of_the_model_served_and_of_its_rep
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         plots = app.gui.plots
-        shown = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values() if c.visible]
+        shown = [c for c in plots.all_charts() if c.visible and c is not plots.error]
         assert len(shown) == 2 and all(_legend(c) == ("suppression on", "suppression off") for c in shown)
         assert "suppression on" in plots.caption.content and "second arm" not in plots.caption.content
         app.session.switch_model("trep2")
         app.session.advance(0.01)
         wait_until(lambda: plots.runs == "compensation", 20.0, "the trep2 panel")
-        shown = [c for sets in plots.chart_sets.values() for m in sets.values() for c in m.values() if c.visible]
+        shown = [c for c in plots.all_charts() if c.visible and c is not plots.error]
         assert len(shown) == 2 and all(_legend(c) == ("compensation on", "compensator held still") for c in shown)
         assert "held still" in plots.caption.content and "suppression on" not in plots.caption.content
         assert "compensating" in plots.peaks.content and "suppression on" not in plots.peaks.content

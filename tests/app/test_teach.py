@@ -157,7 +157,7 @@ def test_hostile_values_for_the_new_controls_are_set_back_and_the_server_lives(t
         ws.set_value(gui_uuid(box), "not a bool")
         ws.set_value(gui_uuid(app.lessons.chooser), "no such lesson")
         ws.click(gui_uuid(app.lessons.start))
-        ws.set_value(gui_uuid(app.replay.seconds), 1e9)
+        ws.set_value(gui_uuid(app.replay.seconds.slider), 1e9)
         time.sleep(1.0)
         wait_until(lambda: box.value is True, 5.0, "the ghost box to be set back")
         assert app.session.snapshot().lesson is None  # nothing started from a name that is no lesson

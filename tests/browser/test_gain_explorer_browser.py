@@ -1,45 +1,64 @@
-"""The gain explorer in a real headless Chromium: the map appears beside the robot, a real mouse click
-on it applies the cell's gains, and screenshots go to artifacts/gain_map_<model>.png."""
+"""The gain explorer in a real headless Chromium: the map appears beside the robot, its drawn pixels agree
+with its numbers and its legend, a real mouse click on it applies the cell's gains, and screenshots go to
+artifacts/gain_map_<model>.png."""
 
 from __future__ import annotations
 
+import io
+import re
 import time
+from collections.abc import Iterator
 
 import numpy as np
+import pytest
+from PIL import Image
 from playwright.sync_api import Page
 
+from rns_viz.analysis import GainMap
+from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.viz.panels.gain_panel import QUANTITIES
-from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction
-from rns_viz.viz.server.app import RnsApp
+from rns_viz.viz.scene.gain_scene import (
+    MISSING_RGB,
+    UNSTABLE_HATCH,
+    UNSTABLE_RGB,
+    GainScene,
+    axis_fraction,
+    colours,
+    map_rates,
+)
+from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
     screenshot,
     settle_for_picture,
+    wait_for_frames,
     wait_for_nodes,
     wait_until,
 )
 
+PROJECT_JS = """(points) => {
+    const m = window.__viserMutable;
+    const node = m?.nodeRefFromName?.["/gain_map"];
+    const camera = m?.camera;
+    const canvas = [...document.querySelectorAll("canvas")].sort(
+        (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
+    )[0];  // the scene's, not a plot's
+    if (!node || !camera || !canvas) return null;
+    node.updateWorldMatrix(true, false);
+    const r = canvas.getBoundingClientRect();
+    return points.map((p) => {
+        const v = node.localToWorld(new node.position.constructor(p[0], p[1], p[2])).project(camera);
+        return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+    });
+}"""  # page pixels of points given in the map's frame, projected by the page's own camera
+
 
 def screen_point(page: Page, local: tuple[float, float, float]) -> tuple[float, float] | None:
     """Page pixel of a point given in the map's frame, projected by the page's own camera."""
-    return page.evaluate(
-        """(p) => {
-            const m = window.__viserMutable;
-            const node = m?.nodeRefFromName?.["/gain_map"];
-            const camera = m?.camera;
-            const canvas = [...document.querySelectorAll("canvas")].sort(
-                (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
-            )[0];  // the scene's, not a plot's
-            if (!node || !camera || !canvas) return null;
-            node.updateWorldMatrix(true, false);
-            const v = node.localToWorld(new node.position.constructor(p[0], p[1], p[2])).project(camera);
-            const r = canvas.getBoundingClientRect();
-            return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
-        }""",
-        list(local),
-    )
+    pixels = page.evaluate(PROJECT_JS, [list(local)])
+    return None if pixels is None else tuple(pixels[0])
 
 
 def test_gain_map_in_chromium(app: RnsApp) -> None:
@@ -101,3 +120,172 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
             assert screenshot(page, "gain_measured_trep").stat().st_size > 10_000
             view = app.session.gain_view()
             print(f"predicted {view.predicted:.3f} 1/s, measured {view.measured.rate:.3f} 1/s")
+
+
+# -- the drawn map against its numbers ---------------------------------------------------------------
+COLOUR_TOLERANCE = 12  # per RGB channel: the legend's numbers are rounded to 3 digits; the page draws exactly
+AGREEING_CELLS = 0.97  # of the cells read: the rest may sit under a mark drawn on the map
+PICTURE_WAIT_S = 20.0  # s: for the page to draw a new map's picture
+
+
+@pytest.fixture(params=["trep", "planar3r", "boom7"], name="map_app")
+def each_model_map_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
+    app = start_app(request.param, port=0, verbose=False)
+    yield app
+    app.stop()
+
+
+def legend_scale(legend: str) -> tuple[float, float]:
+    """The colour scale (1/s) the legend states: 'dark <lo> ... yellow <hi> 1/s'."""
+    found = re.search(r"dark ([-+.\de]+) … yellow ([-+.\de]+) 1/s", legend)
+    assert found, f"no colour scale in the legend {legend!r}"
+    return float(found.group(1)), float(found.group(2))
+
+
+def expected_colours(rates: np.ndarray, scale: tuple[float, float]) -> np.ndarray:
+    """(B, G, 3): the legend's colour of each cell's rate (no such mode: the missing cells' grey)."""
+    want = colours(rates, scale).astype(int)
+    want[~np.isfinite(rates)] = MISSING_RGB
+    return want
+
+
+def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
+    """Put the page's camera in front of the map, looking at its centre (the map fills the view)."""
+    client = next(iter(app.server.get_clients().values()))
+    wait_until(lambda: client.camera.update_timestamp > 0, 10.0, "the page's camera")
+    client.camera.position = scene.centre + 1.0 * scene.size * scene.rotation[:, 2]
+    client.camera.look_at = scene.centre
+    wait_for_frames(page, 10)
+
+
+def screen_cells(page: Page, scene: GainScene, gm: GainMap) -> np.ndarray:
+    """(B, G, 2) page pixels of the cells' centres, projected by the page's own camera (one call)."""
+    us = np.array([axis_fraction(gm.g_b, g) for g in gm.g_b])
+    vs = np.array([axis_fraction(gm.g_m, g) for g in gm.g_m])
+    u, v = np.meshgrid(us, vs, indexing="ij")
+    local = np.stack([(u - 0.5) * scene.size, (v - 0.5) * scene.size, np.zeros_like(u)], axis=-1)
+    pixels = page.evaluate(PROJECT_JS, local.reshape(-1, 3).tolist())
+    assert pixels is not None, "the page's camera or the map was not found"
+    return np.asarray(pixels, dtype=float).reshape(gm.g_b.size, gm.g_m.size, 2)
+
+
+def read_pixels(page: Page, where: np.ndarray) -> np.ndarray:
+    """(..., 3) colours of the page at the pixels ``where`` (..., 2): the median of the 3 x 3 around each."""
+    shot = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
+    x, y = np.rint(where[..., 0]).astype(int), np.rint(where[..., 1]).astype(int)
+    around = [shot[y + dy, x + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    return np.median(np.stack(around), axis=0)
+
+
+def agreeing(gm: GainMap, drawn: np.ndarray, want: np.ndarray) -> np.ndarray:
+    """(B, G) bool: each stable cell drawn in its legend colour, each unstable one hatched grey (any grey
+    between the hatching's two: 3 x 3 pixels may span a stripe)."""
+    lo, hi = min(UNSTABLE_RGB[0], UNSTABLE_HATCH[0]), max(UNSTABLE_RGB[0], UNSTABLE_HATCH[0])
+    grey = (np.ptp(drawn, axis=-1) <= COLOUR_TOLERANCE) & (drawn[..., 0] >= lo - COLOUR_TOLERANCE)
+    grey &= drawn[..., 0] <= hi + COLOUR_TOLERANCE
+    return np.where(gm.stable, np.abs(drawn - want).max(axis=-1) <= COLOUR_TOLERANCE, grey)
+
+
+def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = False) -> tuple[int, int]:
+    """The map drawn in the page agrees cell by cell with the legend's colour of each cell's rate; the
+    cells of the highest and the lowest rate show the legend's two ends. ``hovered``: with the mouse on
+    the map, as when a person picks a cell (viser's hover outline once tinted the whole map yellow).
+    Returns the fastest cell (i, j)."""
+    ex = app.renderer.explorer
+    scene = ex.scene
+    assert scene is not None and scene.gain_map is not None
+    # The marks on the map (now, the paper's points, axis names) are hidden while its pixels are read.
+    marks = [scene.now, *scene._ticks, *scene._paper]  # (what covers cells)
+    for mark in marks:
+        mark.visible = False  # type: ignore[attr-defined]
+    # The page loads a new map's PNG into a texture in its own time (seconds on a busy machine): read
+    # until the drawing agrees or PICTURE_WAIT_S has passed; a wrong picture never agrees.
+    centre = screen_point(page, (0.0, 0.0, 0.0))
+    assert centre is not None
+    page.mouse.move(*(centre if hovered else (5.0, 5.0)))
+    deadline = time.monotonic() + PICTURE_WAIT_S
+    while True:
+        wait_for_frames(page, 10)
+        gm, scale = scene.gain_map, legend_scale(scene.legend.text)  # (the map of the pose now)
+        cells = screen_cells(page, scene, gm)  # (where the page's camera is now)
+        spacing = np.linalg.norm(cells[1, 0] - cells[0, 0])
+        assert spacing >= 6.0, f"cells {spacing:.1f} px apart: too small to read one pixel block each"
+        drawn = read_pixels(page, cells)
+        rates = map_rates(gm, quantity)  # type: ignore[arg-type]
+        want = expected_colours(rates, scale)
+        agree = agreeing(gm, drawn, want)
+        if agree.mean() >= AGREEING_CELLS or time.monotonic() > deadline:
+            break
+    for mark in marks:
+        mark.visible = True  # type: ignore[attr-defined]
+    bad = tuple(np.argwhere(~agree)[0]) if not agree.all() else None
+    assert agree.mean() >= AGREEING_CELLS, (
+        f"{quantity}: only {agree.mean():.0%} of the drawn cells show their legend colour "
+        f"(e.g. cell {bad} drawn {drawn[bad]}, its legend colour {want[bad]})"
+    )
+    stable = gm.stable & np.isfinite(rates) & (rates > 0)
+    fastest = np.unravel_index(np.argmax(np.where(stable, rates, -np.inf)), rates.shape)
+    slowest = np.unravel_index(np.argmin(np.where(stable, rates, np.inf)), rates.shape)
+    bottom, top = colours(np.array(scale), scale).astype(int)  # the legend's dark and yellow ends
+    for (i, j), end, name in ((fastest, top, "highest"), (slowest, bottom, "lowest")):
+        assert np.abs(drawn[i, j] - end).max() <= COLOUR_TOLERANCE, (
+            f"{quantity}: the cell of the {name} rate ({rates[i, j]:.3g} 1/s at g_b {gm.g_b[i]:.3g}, g_m "
+            f"{gm.g_m[j]:.3g}) is drawn {drawn[i, j]}, the legend's {name} end is {end}"
+        )
+    # The check tells an upside-down map: the fastest cell's mirror across the g_m axis has another colour.
+    mirror = want[fastest[0], gm.g_m.size - 1 - fastest[1]]
+    assert np.abs(mirror - top).max() > 4 * COLOUR_TOLERANCE, "this map looks the same upside down"
+    return int(fastest[0]), int(fastest[1])
+
+
+def applied_gains(app: RnsApp) -> tuple[float, float]:
+    gains = app.session.snapshot().settings.gains
+    return gains.g_b, gains.g_m
+
+
+def test_the_drawn_map_agrees_with_its_numbers_legend_and_clicks(map_app: RnsApp) -> None:
+    app = map_app
+    ex = app.renderer.explorer
+    laws = {"trep": ("velocity", "torque"), "planar3r": ("acceleration", "velocity"), "boom7": ("acceleration",)}
+    laws = laws[app.model_name]
+    with browser_page(app.server, width=1280, height=800, draw=True) as page:
+        for law in laws:
+            if app.session.snapshot().settings.law != law:
+                app.controls.show(app.gui.law, LAW_LABELS[law])
+                app.session.set_law(law)
+            wait_until(
+                lambda law=law: (
+                    ex.scene is not None
+                    and ex.scene.gain_map is not None
+                    and ex.scene.gain_map.loop.law == law
+                    and ex.scene.frame.visible
+                ),
+                120.0,
+                f"the gain map of law {law}",
+            )
+            wait_for_nodes(page, {GainScene.FRAME, GainScene.IMAGE})
+            dismiss_notifications(page)
+            scene = ex.scene
+            assert scene is not None
+            face_the_map(app, page, scene)
+            for quantity in ("base", "arm"):
+                app.controls.show(ex.quantity, next(k for k, q in QUANTITIES.items() if q == quantity))
+                sym = "σ_a" if quantity == "arm" else "σ_b"
+                legend = scene.legend
+                wait_until(lambda s=sym, h=legend: h.text.startswith(s), 10.0, f"the {quantity} map")
+                wait_for_frames(page, 10)
+                i, j = check_drawn_map(app, page, quantity)
+                if quantity == "base":
+                    check_drawn_map(app, page, quantity, hovered=True)
+            # A click on the fastest (arm) cell's drawn position applies that cell's gains.
+            gm = scene.gain_map
+            assert gm is not None
+            want = (float(gm.g_b[i]), float(gm.g_m[j]))
+            u, v = axis_fraction(gm.g_b, want[0]), axis_fraction(gm.g_m, want[1])
+            pixel = screen_point(page, ((u - 0.5) * scene.size, (v - 0.5) * scene.size, 0.0))
+            assert pixel is not None
+            dismiss_notifications(page)
+            page.mouse.click(*pixel)
+            wait_until(lambda w=want: applied_gains(app) == w, 10.0, f"the click to apply {want}")
+        settle_for_picture(page, 10)
+        screenshot(page, f"gain_map_facing_{app.model_name}")

@@ -5,23 +5,28 @@ charts must then hold curves over a time axis that covers their data (loading a 
 pin the axis far outside it, "50-150 s", when the chart was rebuilt in the same frame as new data),
 and the peaks shown on the page must carry the paper's contrast: fig11-joint2 moves the base
 hundreds of times more than fig11-fast. Screenshots of both go to artifacts/plots_<preset>_<width>.png.
+The y axes' tick labels, as uPlot drew them, must read: no label twice, no number of five digits.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 from playwright.sync_api import Page
 
+from rns_viz.live.published.plot_buffers import PLOT_SERIES
 from rns_viz.scenarios import SCENARIOS
 from rns_viz.viz.panels.control_panel import PLANAR3R_PRESETS, TREP_PRESETS
-from rns_viz.viz.panels.live_plots import SCALES
+from rns_viz.viz.panels.live_plots import SCALES, LivePlots
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     browser_page,
     dismiss_notifications,
+    local_server,
     screenshot,
     settle_for_picture,
     wait_until,
@@ -36,6 +41,28 @@ CHART_JS = """(uuid) => {
     for (const v of on) peak = Math.max(peak, Math.abs(v));
     return {n: xs.length, x0: xs[0], x1: xs[xs.length - 1], min: c.scales.x.min, max: c.scales.x.max, peak: peak};
 }"""
+
+
+Y_TICKS_JS = """(uuid) => {
+    const c = window.__viserTestpoints?.uplots?.[uuid]?.chart;
+    return c ? {label: c.axes[1].label, ticks: [...(c.axes[1]._values ?? [])], n: c.data[0].length} : null;
+}"""
+
+
+def y_ticks(page: Page, handle: Any) -> dict[str, Any] | None:
+    """The y axis of a chart as the page drew it: its label and its tick labels."""
+    return page.evaluate(Y_TICKS_JS, handle._impl.uuid)
+
+
+def assert_readable_ticks(page: Page, handle: Any, what: str) -> None:
+    """The chart's y tick labels are all different and none has five digits (e.g. "100,000")."""
+    wait_until(lambda: any((y_ticks(page, handle) or {}).get("ticks", [])), 10.0, f"the y ticks of {what}")
+    axis = y_ticks(page, handle)
+    assert axis is not None, what
+    labels = [t for t in axis["ticks"] if t]
+    assert len(labels) >= 2 and len(set(labels)) == len(labels), (what, axis)
+    digits = [len(re.sub(r"\D", "", t.split(".")[0])) for t in labels]
+    assert max(digits) <= 4, (what, axis)
 
 
 @pytest.fixture
@@ -66,6 +93,7 @@ def assert_curves(page: Page, app: RnsApp, t_end: float, what: str) -> None:
         wait_until(drawn, 20.0, f"the {name} plot of {what} to show its curves")
         c = chart(page, handle)
         assert c is not None
+        assert_readable_ticks(page, handle, f"{what}: {name}")
         assert c["min"] <= c["x0"] + 0.05 and c["max"] >= c["x1"] - 0.05, (what, name, c)  # data in view
         assert c["max"] - c["min"] < 2.0 * (c["x1"] - c["x0"]) + 0.1, (what, name, c)  # and not squashed
 
@@ -158,3 +186,38 @@ def test_views_follow_presets_and_notices_reach_the_page(app: RnsApp) -> None:
         s.set_target((0.0, -0.3), final=True, client=client_id)
         s.advance(0.01)
         wait_until(lambda: page.get_by_text("Target moved").count() > 0, 10.0, "the 'Target moved' notice")
+
+
+def test_tick_labels_read_for_every_magnitude() -> None:
+    """Windows from 0.2 nm to 2 m (x_b, |e|) and 5 nN·s to 30 N·s (L), on both scales: each chart shown
+    labels its y axis with distinct numbers of at most four digits (a linear one names its unit). A window
+    of 0.2 nm shown in mm read "0" five times, 25 mm in µm read "-20,000", the symmetric-log x_b "100,000"."""
+    magnitudes = ((2e-10, 5e-9), (2e-9, 2e-7), (2e-7, 3e-5), (5e-6, 0.02), (3e-4, 2.5), (2.5e-2, 30.0), (2.0, 1e-3))
+    with local_server() as server:
+        plots = LivePlots(server.gui)
+        with browser_page(server, width=900, height=1400) as page:
+            for k, (length, momentum) in enumerate(magnitudes):  # (m, N s)
+                for mode in SCALES:
+                    samples = 400 + 2 * k + (mode == "symlog")  # a count of its own: the page has the new data
+                    t = np.linspace(0.0, 10.0, samples)
+                    wave = np.sin(2.0 * np.pi * 0.7 * t)
+                    arrays = {key: np.zeros_like(t) for key in PLOT_SERIES}
+                    arrays["t"], arrays["suppress"] = t, np.ones_like(t)
+                    arrays["xb"], arrays["xb_shadow"] = 1e3 * length * wave, 0.3e3 * length * wave  # mm
+                    arrays["L"], arrays["L_shadow"] = momentum * wave, 0.5 * momentum * wave  # N s
+                    arrays["ee_error"] = 1e3 * length * np.abs(wave)  # mm
+                    plots.show_mode(mode)
+                    assert plots.update(arrays)
+                    shown = [plots.error, *plots.charts[mode].values()]
+
+                    def arrived(shown: list[Any] = shown, samples: int = samples) -> bool:
+                        return all((y_ticks(page, c) or {}).get("n") == samples for c in shown)
+
+                    wait_until(arrived, 10.0, f"the charts of {length:g} m, {momentum:g} N s")
+                    for handle in shown:
+                        axis = y_ticks(page, handle)
+                        assert axis is not None
+                        what = f"{mode}, x_b and |e| {length:g} m, L {momentum:g} N s: {axis}"
+                        assert_readable_ticks(page, handle, what)
+                        if handle is plots.error or mode == "linear":
+                            assert re.search(r"\((nm|µm|mm|m|nN·s|µN·s|mN·s|N·s)\)$", axis["label"]), what

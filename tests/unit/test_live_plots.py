@@ -1,4 +1,5 @@
-"""The live plots' pure parts: SI units, the on/off colouring sample by sample, the peaks table."""
+"""The live plots' pure parts: SI units, the display unit a window is shown in, the on/off colouring sample
+by sample, the peaks table."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import math
 import numpy as np
 
 from rns_viz.live.published.plot_buffers import PLOT_SERIES
-from rns_viz.viz.panels.live_plots import on_off, peaks_html
+from rns_viz.viz.panels.live_plots import LENGTH_UNITS, MOMENTUM_UNITS, display_unit, on_off, peaks_html
 from rns_viz.viz.panels.units import si
 
 
@@ -18,6 +19,18 @@ def test_si_prefixes_and_zeros() -> None:
     assert si(-1.2e-42, "N", floor=1e-6) == "0 N"  # not "-1.2e-42 N"
     assert si(0.9997e-3, "m") == "1 mm"  # not "1e+03 µm"
     assert si(3.0, "N", sign=True) == "+3 N" and si(math.nan, "m") == "—"
+
+
+def test_display_units_suit_the_window() -> None:
+    """The unit a linear chart shows: its peak reads 1 to 1000 of it, kept from 0.5 to 2000 (no flapping)."""
+    assert display_unit(2e-10, LENGTH_UNITS, "mm") == "nm"  # below 1 nm: drawn as 0, in nm
+    assert display_unit(2e-7, LENGTH_UNITS, "mm") == "nm"  # 200 nm, not 0.0002 mm ("0" five times)
+    assert display_unit(2.5e-2, LENGTH_UNITS, "µm") == "mm"  # 25 mm, not 25,000 µm
+    assert display_unit(3.0, LENGTH_UNITS, "mm") == "m"
+    assert display_unit(1.5e-3, LENGTH_UNITS, "µm") == "µm"  # 1500 µm: kept (four digits)
+    assert display_unit(0.6e-6, LENGTH_UNITS, "µm") == "µm" and display_unit(0.4e-6, LENGTH_UNITS, "µm") == "nm"
+    assert display_unit(5e-9, MOMENTUM_UNITS, "mN·s") == "nN·s" and display_unit(30.0, MOMENTUM_UNITS, "mN·s") == "N·s"
+    assert display_unit(0.0, LENGTH_UNITS, "µm") == "µm" and display_unit(math.nan, LENGTH_UNITS, "mm") == "mm"
 
 
 def test_curves_are_coloured_by_suppression_sample_by_sample() -> None:

@@ -100,7 +100,7 @@ class Kick(Command):
 
     def __post_init__(self) -> None:
         if abs(_finite("kick peak", self.peak)) > MAX_KICK_N:
-            raise ValueError(f"kick peak must be a force of at most {MAX_KICK_N:g} N, got {self.peak}")
+            raise ValueError(f"kick peak must be a force of at most {MAX_KICK_N:g} N, got {self.peak:g}")
         if self.direction is not None:
             try:
                 weights = np.asarray(self.direction, dtype=float).reshape(-1)
@@ -153,7 +153,9 @@ class SetUbarSpeed(Command):
 
     def __post_init__(self) -> None:
         if not 0 < _finite("u-bar speed", self.value) <= MAX_UBAR_SPEED:
-            raise InvalidGain(f"u-bar speed must be a positive number up to {MAX_UBAR_SPEED:g} 1/(kg m s)")
+            raise InvalidGain(
+                f"u-bar speed must be a positive number up to {MAX_UBAR_SPEED:g} 1/(kg m s), got {self.value:g}"
+            )
 
 
 @dataclass(frozen=True)
@@ -162,7 +164,9 @@ class SetTargetSpeed(Command):
 
     def __post_init__(self) -> None:
         if not 0 < _finite("target speed", self.value) <= MAX_TARGET_SPEED:
-            raise InvalidGain(f"target speed must be a positive number of m/s up to {MAX_TARGET_SPEED:g}")
+            raise InvalidGain(
+                f"target speed must be a positive number of m/s up to {MAX_TARGET_SPEED:g}, got {self.value:g}"
+            )
 
 
 @dataclass(frozen=True)
@@ -303,7 +307,7 @@ class StartReplay(ReplayCommand):
 
     def __post_init__(self) -> None:
         if not 0.0 < _finite("replay length", self.seconds) <= MAX_RECORD_S:
-            raise ValueError(f"replay length must be more than 0 and at most {MAX_RECORD_S:g} s, got {self.seconds}")
+            raise ValueError(f"replay length must be more than 0 and at most {MAX_RECORD_S:g} s, got {self.seconds:g}")
 
 
 @dataclass(frozen=True)
@@ -322,7 +326,7 @@ class SetReplaySpeed(ReplayCommand):
     def __post_init__(self) -> None:
         lo, hi = REPLAY_SPEEDS
         if not lo <= _finite("replay speed", self.speed) <= hi:
-            raise ValueError(f"replay speed must be from {lo:g}x to {hi:g}x, got {self.speed}")
+            raise ValueError(f"replay speed must be from {lo:g}x to {hi:g}x, got {self.speed:g}")
 
 
 @dataclass(frozen=True)

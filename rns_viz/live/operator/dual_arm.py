@@ -150,7 +150,7 @@ def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarra
     if out is None:
         return None
     if out.sigma_hbm < warn_sigma:
-        return f"compensator near its singularity (σ = {out.sigma_hbm:.2g} kg·m): it cannot cancel"
+        return f"compensator near its singularity (σ_min(S H_bm,2) = {out.sigma_hbm:.2g} kg·m): it cannot cancel"
     L_task = float(out.extra.get("L_task", 0.0)) if out.extra else 0.0
     residual = float(np.linalg.norm(out.coupling_momentum))
     if L_task > CANCEL_FLOOR and residual > CANCEL_RATIO * L_task:

@@ -4,6 +4,8 @@ A :class:`Lesson` says what it is about (a sentence or two and the paper's equat
 (model, law, suppression; the shadow run shown), gives the student a task and checks it
 from the simulation: a :class:`Check` observes the run every few steps and says when the task is
 done. Checks start afresh when the run restarts (reset, model switch). Nothing here imports viser.
+A control the student is to use is named in *italics* exactly as the panel labels it (a test checks
+every name against the app's controls).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 
 from rns_viz.live.teaching.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
 from rns_viz.live.teaching.lessons_boom import BOOM7_LESSONS
+from rns_viz.scenarios import FIG11_SLOW_S
 
 
 class KickAndSwing(Check):
@@ -70,7 +73,7 @@ class StaysStill(Check):
     def progress(self) -> Progress:
         turned = math.degrees(getattr(self, "turned", 0.0))
         if self.peak >= self.LIMIT_M:
-            return Progress(False, f"The base moved {self.peak * 1e3:.2f} mm: too much. Press Reset and try again.")
+            return Progress(False, f"The base moved {self.peak * 1e3:.2f} mm: too much. Press *Reset* and try again.")
         return Progress(self.done, f"Joint 2 turned {turned:.0f} deg; base deflection so far {self.peak * 1e6:.1f} µm.")
 
 
@@ -115,7 +118,7 @@ class SuppressedVersusShadow(Check):
 
 
 class WeakestPoint(Check):
-    """Hold the arm where sigma(S H_bm) is at most 65 % of its value at the start configuration."""
+    """Hold the arm where sigma_min(S H_bm) is at most 65 % of its value at the start configuration."""
 
     def update(self, v: RunView) -> None:
         self.ratio = v.sigma_hbm / self.sigma0
@@ -123,7 +126,7 @@ class WeakestPoint(Check):
 
     def progress(self) -> Progress:
         ratio = getattr(self, "ratio", 1.0)
-        return Progress(self.done, f"sigma(H_bm) here is {ratio:.0%} of its value at the start.")
+        return Progress(self.done, f"σ_min(S H_bm) here is {ratio:.0%} of its value at the start.")
 
 
 class CyclicAndKick(Check):
@@ -143,7 +146,7 @@ class CyclicAndKick(Check):
 
     def progress(self) -> Progress:
         if self.peak <= 1e-4:
-            return Progress(False, "Start cyclic motion, then kick.")
+            return Progress(False, "Press *Start cyclic motion*, then *Kick the base*.")
         return Progress(self.done, f"Swing now {self.ratio:.0%} of its peak, the arm still circling.")
 
 
@@ -184,7 +187,7 @@ class ClampedTarget(Check):
 
     def progress(self) -> Progress:
         if not self.clamped:
-            return Progress(False, "Drag the target far out of the shaded region.")
+            return Progress(False, "Drag the target far out of the lilac dots.")
         return Progress(self.done, "The target was moved into the set; the arm went as far as it can.")
 
 
@@ -212,7 +215,7 @@ TREP_LESSONS = (
     Lesson(
         "The base is a spring",
         "Eq. (1)",
-        "TREP (a two-link arm on a flexible beam) has its arm bolted to the beam's tip: that tip is the *base*. "
+        "TREP (a two-link arm on a flexible beam) has its arm bolted to the beam's tip: that tip is the **base**. "
         "It moves like a mass on a spring (Eq. (1), the equation of motion), pushed by outside forces and "
         "by the arm's own motion. With the joints held, nothing damps it. Its bend x_b is drawn enlarged "
         "(x10 by default).",
@@ -225,7 +228,7 @@ TREP_LESSONS = (
         "A motion that pushes",
         "Eq. (8): L = H_bm θ'",
         "Every joint motion carries coupling momentum L = H_bm θ' into the base, unless it is reactionless.",
-        "Press 'Point to point': joint 2 turns alone by half a turn. Watch the base.",
+        "Press *Same end points, joint space*: joint 2 turns alone by half a turn. Watch the base.",
         LessonStart("trep", "velocity", True),
         ShakesTheBase,
     ),
@@ -234,8 +237,8 @@ TREP_LESSONS = (
         "Eqs. (27), (30): θ' = n ū",
         "Moving along n, the null-space vector of H_bm, keeps L = 0: the base feels nothing. ū (1/(kg m s)) "
         "sets the speed along the path.",
-        "Move along the path (Play slowly, or drag the handle) so the arm reaches the other side with the "
-        "base deflection below 0.1 mm.",
+        f"Move along the path (*Play path slowly ({FIG11_SLOW_S:g} s)*, or drag the handle) so the arm reaches "
+        "the other side with the base deflection below 0.1 mm.",
         LessonStart("trep", "velocity", True),
         StaysStill,
     ),
@@ -244,16 +247,16 @@ TREP_LESSONS = (
         "Eq. (30): θ'_cmd = H_bm⁺ m_b g_b x_b + g_m (θ_ref − θ)",
         "The arm damps the base by a motion outside the reaction null space, proportional to the deflection. "
         "The shadow run gets the same kick with suppression off.",
-        "Kick the base and compare the arm with its shadow.",
+        "Press *Kick the base* and compare the arm with its shadow.",
         LessonStart("trep", "velocity", True),
         SuppressedVersusShadow,
     ),
     Lesson(
         "Where suppression is weakest",
         "Eq. (30): H_bm⁺",
-        "The smaller σ(H_bm), the faster the joints must turn for the same push on the base; where H_bm "
-        "vanishes the arm has no authority over the base at all.",
-        "Move along the path to where σ(H_bm) (readout) is at most 65 % of its start value, and stop there.",
+        "The smaller the distance to singularity σ_min(S H_bm), the faster the joints must turn for the same "
+        "push on the base; where it vanishes the arm has no authority over the base at all.",
+        "Move along the path to where σ_min(S H_bm) (readout) is at most 65 % of its start value, and stop there.",
         LessonStart("trep", "velocity", True),
         WeakestPoint,
     ),
@@ -262,7 +265,7 @@ TREP_LESSONS = (
         "Fig. 12",
         "Reactionless motion and vibration suppression add up: the first never reaches the base, the "
         "second acts only on it.",
-        "Start cyclic motion along the path, then kick the base.",
+        "Press *Start cyclic motion* (the arm goes round the path), then *Kick the base*.",
         LessonStart("trep", "velocity", True),
         CyclicAndKick,
     ),
@@ -282,8 +285,8 @@ PLANAR3R_LESSONS = (
         "The reactionless-reachable set",
         "Sec. V",
         "Without reaction the arm's centre of mass cannot move along the base direction, so only part of "
-        "the workspace is reachable: the shaded region. Its fold curves are where J-bar loses rank.",
-        "Drag the target far outside the shaded region and watch where the arm goes and where it stops.",
+        "the workspace is reachable: the region of small lilac dots. Its fold curves are where J-bar loses rank.",
+        "Drag the target far outside the lilac dots and watch where the arm goes and where it stops.",
         LessonStart("planar3r", "acceleration", True),
         ClampedTarget,
     ),
@@ -292,7 +295,7 @@ PLANAR3R_LESSONS = (
         "Eq. (15)",
         "Law (15) damps the base by moving the arm's centre of mass; the end effector keeps its target, so "
         "the arm swings its elbow to do it.",
-        "Kick the base with 2 N or more and watch the arm absorb it.",
+        "Press *Kick the base* (2 N or more) and watch the arm absorb it.",
         LessonStart("planar3r", "acceleration", True),
         AbsorbKick,
     ),

@@ -94,7 +94,7 @@ class BoomStaysStill(Check):
         if self.peak >= self.LIMIT:
             return Progress(
                 False,
-                f"The boom moved {self.peak * 1e6:.2f} µm or µrad: too much (a kick?). Press Reset and try again.",
+                f"The boom moved {self.peak * 1e6:.2f} µm or µrad: too much (a kick?). Press *Reset* and try again.",
             )
         return Progress(
             self.done,

@@ -22,6 +22,7 @@ from rns_viz.params import model_source
 from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, PANDA_SCENARIOS
 from rns_viz.viz.panels.live_plots import LivePlots
 from rns_viz.viz.panels.model_menu import ModelMenu
+from rns_viz.viz.panels.number_field import NumberField, hide_slider_boxes
 
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
@@ -90,7 +91,7 @@ class GuiElements:
 
     status: viser.GuiHtmlHandle
     kick: viser.GuiButtonHandle
-    kick_peak: viser.GuiSliderHandle
+    kick_peak: NumberField
     suppression: viser.GuiCheckboxHandle
     pause: viser.GuiButtonHandle
     step: viser.GuiButtonHandle
@@ -98,19 +99,18 @@ class GuiElements:
     speed: viser.GuiDropdownHandle
     readouts: viser.GuiHtmlHandle
     plots: LivePlots
-    plot_error: viser.GuiUplotHandle
     path_folder: viser.GuiFolderHandle
-    sigma: viser.GuiSliderHandle
+    sigma: NumberField
     play_slow: viser.GuiButtonHandle
     play_fast: viser.GuiButtonHandle
     cyclic: viser.GuiButtonHandle
     point_to_point: viser.GuiButtonHandle
-    ubar_speed: viser.GuiSliderHandle
+    ubar_speed: NumberField
     target_folder: viser.GuiFolderHandle
     target_text: viser.GuiMarkdownHandle
-    target_speed: viser.GuiSliderHandle
+    target_speed: NumberField
     law: viser.GuiDropdownHandle
-    gains: dict[str, viser.GuiSliderHandle]
+    gains: dict[str, NumberField]
     presets_trep: viser.GuiButtonGroupHandle
     presets_3r: viser.GuiButtonGroupHandle
     presets_dual: viser.GuiButtonGroupHandle
@@ -120,7 +120,7 @@ class GuiElements:
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
     menu: ModelMenu
-    exaggeration: viser.GuiSliderHandle
+    exaggeration: NumberField
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
 
@@ -133,6 +133,11 @@ class GuiElements:
     def plot_L(self) -> viser.GuiUplotHandle:
         return self.plots.L
 
+    @property
+    def plot_error(self) -> viser.GuiUplotHandle:
+        """The end-effector error chart shown now (its unit suits the data)."""
+        return self.plots.error
+
 
 def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = None) -> GuiElements:
     """Build the panel for ``model`` (its kick range and exaggeration; ``menu``: the models offered, by
@@ -141,6 +146,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     gui = server.gui
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
     gui.main_panel.dock_right()
+    hide_slider_boxes(gui)  # every slider's value is shown and typed in its NumberField's box
     status = gui.add_html("")
     gui.add_markdown(
         "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
@@ -153,13 +159,15 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             color="red",
             hint="Push the base once with a short force pulse (size below, N); the shadow run gets the same push.",
         )
-        kick_peak = gui.add_slider(
+        kick_peak = NumberField(
+            gui,
             "Kick peak (N)",
             min=-defaults_for(model).kick_range_N,
             max=defaults_for(model).kick_range_N,
             step=0.1,
             initial_value=defaults_for(model).kick_peak_N,
             hint="Peak of the half-sine force pulse on the base (N); the app says more per model.",
+            bounded=True,  # read at the next kick
         )
         suppression = gui.add_checkbox(
             "Vibration suppression",
@@ -198,7 +206,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "Drag the handle labelled **drag me** in the scene: the end effector moves along its current "
             "reactionless path (red) to the point nearest the handle. Or scrub the path position."
         )
-        sigma = gui.add_slider(
+        sigma = NumberField(
+            gui,
             "Path ∫ū dt (1/(kg·m))",
             min=-80.0,
             max=80.0,
@@ -206,6 +215,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             initial_value=0.0,
             hint="Where the arm is along its reactionless path; the paper's ∫ū dt of Eq. (30), in 1/(kg·m). "
             "The line below says it in joint angles.",
+            bounded=True,  # the path's range (the loop would take any number to its nearest end)
         )
         play_slow = gui.add_button(
             f"Play path slowly ({FIG11_SLOW_S:g} s)",
@@ -228,7 +238,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             icon=viser.Icon.REPEAT,
             hint="Go round the path again and again at the ū speed below.",
         )
-        ubar_speed = gui.add_slider(
+        ubar_speed = NumberField(
+            gui,
             "ū speed (1/(kg·m·s))",
             min=1.0,
             max=100.0,
@@ -236,16 +247,19 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             initial_value=30.0,
             hint="How fast the arm moves along the path, the paper's ū in 1/(kg·m·s) (Fig. 12 uses 30); "
             "the line above turns it into joint speeds.",
+            bounded=False,
         )
     with gui.add_folder("Target") as target_folder:
         target_text = gui.add_markdown("")  # how the handle works for the model served (model_words)
-        target_speed = gui.add_slider(
+        target_speed = NumberField(
+            gui,
             "Target speed (m/s)",
             min=0.05,
             max=2.0,
             step=0.05,
             initial_value=0.5,
             hint="Speed limit of the smoothed target.",
+            bounded=False,
         )
     with gui.add_folder("Control law and gains", expand_by_default=False):
         law = gui.add_dropdown(
@@ -256,7 +270,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "or velocities (30).",
         )
         gains = {
-            name: gui.add_slider(label, min=lo, max=hi, step=step, initial_value=lo, hint=hint)
+            name: NumberField(gui, label, min=lo, max=hi, step=step, initial_value=lo, hint=hint, bounded=False)
             for name, label, lo, hi, step, hint in GAIN_SLIDERS
         }
     with gui.add_folder("Model and view", expand_by_default=False):
@@ -268,13 +282,15 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "TREP with a compensating arm: a second arm on the beam tip cancels the first one's reaction. The "
             "7-DOF arm on a flexible boom: a spatial system, six base coordinates. Files: given with --model.",
         )
-        exaggeration = gui.add_slider(
+        exaggeration = NumberField(
+            gui,
             "Deflection drawn ×",
             min=1.0,
             max=100.0,
             step=1.0,
             initial_value=defaults_for(model).exaggeration,
             hint="The base deflection is drawn this many times larger than simulated.",
+            bounded=True,  # only drawn
         )
         speed = gui.add_dropdown(
             "Speed",
@@ -304,7 +320,6 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         speed=speed,
         readouts=readouts,
         plots=plots,
-        plot_error=plots.error,
         path_folder=path_folder,
         sigma=sigma,
         play_slow=play_slow,

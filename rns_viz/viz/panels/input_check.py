@@ -4,6 +4,7 @@ viser casts a client's value with ``type(current)(new)`` before our callbacks ru
 and out-of-range numbers still arrive here; anything else odd (a server-side assignment of the
 wrong type) too. :func:`check_value` raises ``ValueError`` with a message for the user. What a
 value means (a stable gain, a reachable target) is the session's to check, not this module's.
+Typed numbers arrive as text: :func:`parse_number` reads them (and only reads them).
 """
 
 from __future__ import annotations
@@ -38,3 +39,15 @@ def check_value(handle: Any, value: Any) -> None:
             raise ValueError(f"{label}: expected on or off, got {value!r}")
     elif isinstance(handle, viser.GuiDropdownHandle | viser.GuiButtonGroupHandle) and value not in handle.options:
         raise ValueError(f"{label}: {value!r} is not one of the choices")
+
+
+def parse_number(label: str, text: str) -> float:
+    """The number a person typed (``1e9``, ``-0.5``, `` 12 ``; ``-0`` is 0); ValueError if it is none.
+
+    Only the reading: whether the number is finite and in range is checked by what it becomes."""
+    try:
+        value = float(text.strip())
+    except (AttributeError, ValueError):
+        shown = text if len(str(text)) <= 40 else f"{str(text)[:40]}…"
+        raise ValueError(f"{label}: {shown!r} is not a number (numbers look like 2.5, -0.3 or 1e-3)") from None
+    return value + 0.0  # -0.0 becomes 0.0

@@ -3,8 +3,11 @@
 A callback checks only what belongs to the widget (a slider value of the right type within its
 bounds, a dropdown value among its options, a finite drag position; see
 :mod:`rns_viz.viz.panels.input_check`) and calls the session's command method, which checks the meaning
-(gains, speeds, targets) and raises ``ValueError`` if it refuses. Refused input is reported to its
-client and the control is shown its last good value again at the next render frame.
+(gains, speeds, targets) and raises ``ValueError`` if it refuses. A number typed into a
+:class:`~rns_viz.viz.panels.number_field.NumberField` is only read here (text that is no number is refused);
+its range is the command's to check (or the field's, for a value no command takes at once). Refused
+input is reported to its client and the control is shown its last good value again at the next
+render frame.
 """
 
 from __future__ import annotations
@@ -23,8 +26,9 @@ from rns_viz.live.loop.session import Session
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements
-from rns_viz.viz.panels.input_check import check_value
+from rns_viz.viz.panels.input_check import check_value, parse_number
 from rns_viz.viz.panels.live_plots import SCALES
+from rns_viz.viz.panels.number_field import NumberField
 
 REFUSAL_REPEAT_S = 2.0  # s: a watcher dragging the handle is told at most this often
 
@@ -69,9 +73,11 @@ class Controls:
     def show(self, handle: Any, value: Any) -> None:
         """Show ``value`` (a value in force) on ``handle`` and remember it as good."""
         self._good[id(handle)] = value
-        if handle.value != value:
-            with self.quiet():
+        with self.quiet():
+            if handle.value != value:
                 handle.value = value
+            if isinstance(handle, NumberField):
+                handle.show_text()  # (after a refused typed number the slider still holds the value)
 
     def good(self, handle: Any) -> Any:
         """The last good value of a GUI control (what the app acts on)."""
@@ -101,36 +107,68 @@ class Controls:
     # ---------------------------------------------------------------- wiring
     def _on_input(self, handle: Any, act: Act, button: bool = False) -> None:
         """Wire ``handle`` to ``act(value, client_id)``; refused input is reported and reverted."""
-        notify = self.connections.notify
+        if isinstance(handle, NumberField):
+            self._on_number(handle, act)
+            return
 
         def callback(event: viser.GuiEvent) -> None:
             if getattr(self._local, "quiet", False):
                 return
-            client = event.client
-            if not self.connections.allowed(client):
-                self.connections.refuse_watcher(client)
-                self._revert(handle)
-                return
-            value = event.target.value
-            try:
-                if not button or isinstance(handle, viser.GuiButtonGroupHandle):
-                    check_value(handle, value)
-                act(value, None if client is None else client.client_id)
-                if not button:
-                    self._good[id(handle)] = value
-            except ValueError as exc:  # InvalidGain, InputRefused, values the widget cannot hold
-                notify(client, "Input not applied", str(exc), "warning")
-                self._revert(handle)  # show the value still in force
-            except Exception as exc:
-                traceback.print_exc()
-                notify(client, "Input not applied", f"{type(exc).__name__}: {exc}", "error")
-                self._revert(handle)
+            checked = not button or isinstance(handle, viser.GuiButtonGroupHandle)
+            self._apply(handle, event.client, event.target.value, act, check=checked, keep=not button)
 
         if button:
             handle.on_click(callback)
         else:
             self._good[id(handle)] = handle.value
             handle.on_update(callback)
+
+    def _on_number(self, field: NumberField, act: Act) -> None:
+        """A number field: its slider dragged (a value in the slider's range) or a number typed in its box
+        (read here; checked against the field's range if ``field.bounded``, else by the command)."""
+        self._good[id(field)] = field.value
+
+        def dragged(event: viser.GuiEvent) -> None:
+            if not getattr(self._local, "quiet", False):
+                self._apply(field, event.client, event.target.value, act, check=True, keep=True)
+
+        def typed(client: viser.ClientHandle, text: str) -> None:
+            if not self.connections.allowed(client):
+                self.connections.refuse_watcher(client)
+            elif text.strip():  # (a cleared box: nothing was typed; it shows the value again)
+                try:
+                    value = parse_number(field.label, text)
+                except ValueError as exc:
+                    self.connections.notify(client, "Input not applied", str(exc), "warning")
+                else:
+                    self._apply(field, client, value, act, check=field.bounded, keep=True)
+            self._reverts[id(field)] = field  # the box shows the value in force (a typed one written plainly)
+
+        field.slider.on_update(dragged)
+        field.on_typed(typed)
+
+    def _apply(self, handle: Any, client: viser.ClientHandle | None, value: Any, act: Act, check: bool,
+               keep: bool) -> None:  # fmt: skip
+        """Act on one input of ``client``: refused (a watcher, a value the control cannot hold, or the
+        command's ValueError) it is reported and the control shows its last good value again."""
+        notify = self.connections.notify
+        if not self.connections.allowed(client):
+            self.connections.refuse_watcher(client)
+            self._revert(handle)
+            return
+        try:
+            if check:
+                check_value(handle.slider if isinstance(handle, NumberField) else handle, value)
+            act(value, None if client is None else client.client_id)
+            if keep:
+                self._good[id(handle)] = value
+        except ValueError as exc:  # InvalidGain, InputRefused, values the widget cannot hold
+            notify(client, "Input not applied", str(exc), "warning")
+            self._revert(handle)  # show the value still in force
+        except Exception as exc:
+            traceback.print_exc()
+            notify(client, "Input not applied", f"{type(exc).__name__}: {exc}", "error")
+            self._revert(handle)
 
     on_input = _on_input  # for panels built elsewhere (viz/panels/gain_panel.py)
 

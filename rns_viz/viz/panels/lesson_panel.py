@@ -44,9 +44,10 @@ LESSON_VIEWS: dict[tuple[str, int], tuple[str, ...]] = {
     ("boom7", 3): (*BASICS, "coupling"),
 }
 NO_LESSON = (
-    "No lesson running. Pick one below and press **Start**, or press **Next** for lesson 1. Each lesson loads "
-    "a state, gives you a task and tells you when the simulation shows it done."
+    "No lesson running. Pick one under *Lesson* and press *Start*, or press *Next* for lesson 1. Each lesson "
+    "loads a state, gives you a task and tells you when the simulation shows it done."
 )
+LAST_DONE = "That was the last lesson of this model: pick another under *Lesson* and press *Start*."
 
 
 def chooser_entry(status: LessonStatus | None, model: str) -> str:
@@ -61,7 +62,8 @@ def lesson_markdown(status: LessonStatus | None) -> str:
     if status is None:
         return NO_LESSON
     mark = " ✓" if status.done else ""
-    progress = "**Done.** Press *Next* for the next lesson." if status.done else status.progress
+    then = "Press *Next* for the next lesson." if status.number < status.count else LAST_DONE  # (Next: disabled)
+    progress = f"**Done.** {then}" if status.done else status.progress
     return (
         f"**Lesson {status.number} of {status.count}: {status.title}**{mark}\n\n"
         f"*Paper: {status.equation}*\n\n{status.text}\n\n**Task:** {status.task}\n\n{progress}"

@@ -6,8 +6,13 @@ frame as new data it keeps the destroyed chart's x range as a *relative* zoom, w
 axis far outside the data (e.g. 50-150 s) in every tab until a reload. So nothing but data is ever
 sent to a chart; the meaning of the colours is fixed (blue: suppression on, red: off, whichever run
 is operated; for a model with a compensating arm, blue: compensation on, red: compensator held
-still), the y scale and the legend's names are chosen by showing one of the prebuilt charts (a new
-chart mounts fresh), and the peaks are HTML beside them.
+still), the y scale, the display unit and the legend's names are chosen by showing one of the prebuilt charts
+(a new chart mounts fresh), and the peaks are HTML beside them.
+
+Tick labels: uPlot prints numbers with at most three decimals and thousands separators, so a window of
+0.2 nm shown in mm read "0" five times and centimetres in µm "10,000". Each linear chart exists once per
+display unit and the one shown suits the window's peak (:func:`display_unit`); the symmetric-log charts
+have fixed ticks labelled with their own prefixes (``100 mm``, ``10 µm``).
 """
 
 from __future__ import annotations
@@ -23,13 +28,32 @@ from rns_viz.viz.panels.units import si
 
 ON_COLOUR, OFF_COLOUR, ERROR_COLOUR = "#1f6fd1", "#e0503a", "#2a9d4b"
 SCALES = {"linear": "linear, fits the data", "symlog": "symmetric log, fixed range"}
-# Display units: x_b in µm and L in mN·s (= g·m/s) keep tick labels readable from the 3R's
-# centimetres down to fig11-fast's micrometres; the error in mm.
-XB_UM_PER_MM = 1e3  # the plot buffers carry x_b in mm
-L_MNS_PER_SI = 1e3
-# symmetric-log charts: fixed range and linear threshold (uPlot distr 4, asinh), display units
-XB_SYMLOG = (1e5, 0.1)  # ±100 mm, linear below 0.1 µm
-L_SYMLOG = (1e4, 1e-3)  # ±10 kg·m/s, linear below 1 µN·s
+# Display units of the linear charts (name, SI value): one chart per unit, the one shown suits the data.
+LENGTH_UNITS = (("nm", 1e-9), ("µm", 1e-6), ("mm", 1e-3), ("m", 1.0))
+MOMENTUM_UNITS = (("nN·s", 1e-9), ("µN·s", 1e-6), ("mN·s", 1e-3), ("N·s", 1.0))
+UNITS = {"xb": LENGTH_UNITS, "L": MOMENTUM_UNITS, "e": LENGTH_UNITS}
+FIRST_UNIT = {"xb": "µm", "L": "mN·s", "e": "mm"}
+SI_PER_BUFFER = {"xb": 1e-3, "L": 1.0, "e": 1e-3}  # the plot buffers carry x_b and |e| in mm, L in N·s
+KEEP_UNIT = (0.5, 2000.0)  # a unit is kept while the window's peak reads this many of it (no flapping)
+# Symmetric-log charts: fixed range and linear threshold (uPlot distr 4, asinh) in their display unit,
+# and fixed ticks labelled with prefixes (uPlot would print 100,000 µm).
+XB_SYMLOG = (1e5, 0.1)  # µm: ±100 mm, linear below 0.1 µm
+L_SYMLOG = (1e4, 1e-3)  # mN·s: ±10 N·s, linear below 1 µN·s
+XB_SYMLOG_TICKS = ((1e5, "100 mm"), (1e3, "1 mm"), (10.0, "10 µm"))
+L_SYMLOG_TICKS = ((1e4, "10 N·s"), (1e2, "100 mN·s"), (1.0, "1 mN·s"))
+
+
+def display_unit(peak_si: float, units: tuple[tuple[str, float], ...], current: str) -> str:
+    """The unit to show a window whose largest magnitude is ``peak_si`` (SI) in: ``current`` while the
+    peak reads KEEP_UNIT of it, else the one it reads 1 to 1000 of (the smallest unit for anything less,
+    the largest for more). A zero window keeps ``current``."""
+    if not (math.isfinite(peak_si) and peak_si > 0.0):
+        return current
+    lo, hi = KEEP_UNIT
+    if lo <= peak_si / dict(units)[current] < hi:
+        return current
+    fitting = [name for name, size in units if peak_si >= size]
+    return fitting[-1] if fitting else units[0][0]
 
 
 def peak(x: np.ndarray) -> float:
@@ -52,17 +76,22 @@ def _chart(
     curves: tuple[tuple[str, str], ...],
     y_scale: viser.uplot.Scale,
     visible: bool = True,
+    ticks: tuple[tuple[float, str], ...] = (),
 ) -> viser.GuiUplotHandle:
+    """A chart; ``ticks``: fixed (value, label) pairs of the positive half of a symmetric y axis."""
     series: list[viser.uplot.Series] = [{"label": "t (s)"}]
     series += [{"label": label, "stroke": colour, "width": 1.5} for label, colour in curves]
+    # px; a log axis draws no tick marks (uPlot packs the negative half's minor ones into a solid bar)
+    y_axis: viser.uplot.Axis = {"label": y_label, "size": 64, "ticks": {"show": y_scale.get("distr") != 4}}
+    if ticks:
+        y_axis["splits"] = (*(-v for v, _ in ticks), 0.0, *(v for v, _ in reversed(ticks)))
+        y_axis["values"] = (*(f"−{label}" for _, label in ticks), "0", *(label for _, label in reversed(ticks)))
     return gui.add_uplot(
         data=tuple(np.zeros(2) for _ in range(len(curves) + 1)),
         series=tuple(series),
         title=title,
         scales={"x": {"time": False, "auto": True}, "y": y_scale},
-        # px; time in s (the legend's first entry); a log axis draws no tick marks (uPlot packs the
-        # negative half's minor ones into a solid bar)
-        axes=({"size": 28}, {"label": y_label, "size": 64, "ticks": {"show": y_scale.get("distr") != 4}}),
+        axes=({"size": 28}, y_axis),  # time in s (the legend's first entry)
         legend={"show": True, "live": False},
         cursor={"show": False},
         aspect=2.1,
@@ -72,9 +101,9 @@ def _chart(
 
 
 PLOTS_CAPTION = (
-    '<div style="font-size:0.75em;opacity:0.8">The last 10 s: how far the base is bent, x_b (µm); the momentum '
-    "the arm's joints hand to the base, L (mN·s = g·m/s); how far the hand is from where it is sent, |e| (mm). "
-    "{runs}</div>"
+    '<div style="font-size:0.75em;opacity:0.8">The last 10 s: how far the base is bent, x_b; the momentum '
+    "the arm's joints hand to the base, L (1 mN·s = 1 g·m/s); how far the hand is from where it is sent, |e|. "
+    "Each axis is in the unit its numbers read best in; less than 1 nm or 1 nN·s is drawn as 0. {runs}</div>"
 )
 # (blue header, red header, note) of the peaks table, the legend's two names and the caption's sentence on
 # the two runs: one arm (suppression) or two (compensation)
@@ -109,19 +138,26 @@ class LivePlots:
         linear: viser.uplot.Scale = {"auto": True}
         # charts take no hint: their meaning in plain words
         self.caption = gui.add_html(PLOTS_CAPTION.format(runs=RUNS_SENTENCE["suppression"]))
-        # runs -> scale -> chart: one set of charts per legend (a chart's series names cannot change)
-        self.chart_sets: dict[str, dict[str, dict[str, viser.GuiUplotHandle]]] = {runs: {} for runs in RUNS}
+        # (runs, scale, quantity, unit) -> chart: one per legend (a chart's series names cannot change),
+        # scale and display unit (nor can its axis); the error chart's runs and scale are None
+        self.chart_set: dict[tuple[str | None, str | None, str, str], viser.GuiUplotHandle] = {}
+        titles = {"xb": ("Base deflection", "x_b"), "L": ("Coupling momentum", "L")}
         for runs in RUNS:
-            for mode in SCALES:
-                xb_scale, L_scale = linear, linear
-                if mode == "symlog":
-                    xb_scale = _symlog(XB_SYMLOG)
-                    L_scale = _symlog(L_SYMLOG)
-                self.chart_sets[runs][mode] = {
-                    "xb": _chart(gui, "Base deflection", "x_b (µm)", LEGEND[runs], xb_scale, visible=False),
-                    "L": _chart(gui, "Coupling momentum", "L (mN·s)", LEGEND[runs], L_scale, visible=False),
-                }
-        self.error = _chart(gui, "End-effector error", "|e| (mm)", (("|x_ref − x_e|", ERROR_COLOUR),), linear)
+            for name, (title, symbol) in titles.items():
+                for unit, _ in UNITS[name]:
+                    self.chart_set[runs, "linear", name, unit] = _chart(
+                        gui, title, f"{symbol} ({unit})", LEGEND[runs], linear, visible=False
+                    )
+            self.chart_set[runs, "symlog", "xb", "µm"] = _chart(
+                gui, "Base deflection", "x_b", LEGEND[runs], _symlog(XB_SYMLOG), False, XB_SYMLOG_TICKS
+            )
+            self.chart_set[runs, "symlog", "L", "mN·s"] = _chart(
+                gui, "Coupling momentum", "L", LEGEND[runs], _symlog(L_SYMLOG), False, L_SYMLOG_TICKS
+            )
+        for unit, _ in LENGTH_UNITS:
+            self.chart_set[None, None, "e", unit] = _chart(
+                gui, "End-effector error", f"|e| ({unit})", (("|x_ref − x_e|", ERROR_COLOUR),), linear, False
+            )
         self.peaks = gui.add_html(peaks_html(None))
         self.scale = gui.add_dropdown(
             "Plot scale",
@@ -133,12 +169,29 @@ class LivePlots:
         self.mode = "linear"
         self.runs = "suppression"  # what the two runs are: the app sets it per model (``sides``)
         self.empty = True  # the charts show no run (as built, or cleared since)
+        self.units = dict(FIRST_UNIT)  # quantity -> the display unit of its linear chart shown
         self.show_mode("linear")
+
+    def _key(self, name: str, mode: str | None = None) -> tuple[str | None, str | None, str, str]:
+        """The chart of quantity ``name`` shown in scale ``mode`` (default: the one shown)."""
+        if name == "e":
+            return None, None, "e", self.units["e"]
+        mode = mode or self.mode
+        unit = self.units[name] if mode == "linear" else ("µm" if name == "xb" else "mN·s")
+        return self.runs, mode, name, unit
 
     @property
     def charts(self) -> dict[str, dict[str, viser.GuiUplotHandle]]:
-        """The charts of the model's two runs, by scale."""
-        return self.chart_sets[self.runs]
+        """The x_b and L charts of the model's two runs that each scale shows now, by scale."""
+        return {mode: {name: self.chart_set[self._key(name, mode)] for name in ("xb", "L")} for mode in SCALES}
+
+    @property
+    def error(self) -> viser.GuiUplotHandle:
+        """The end-effector error chart shown now."""
+        return self.chart_set[self._key("e")]
+
+    def all_charts(self) -> list[viser.GuiUplotHandle]:
+        return list(self.chart_set.values())
 
     @property
     def sides(self) -> tuple[str, str, str]:
@@ -170,10 +223,10 @@ class LivePlots:
     def show_mode(self, mode: str) -> None:
         """Show the charts of scale ``mode`` (a hidden chart unmounts; shown again it mounts fresh)."""
         self.mode = mode
-        for runs, sets in self.chart_sets.items():
-            for name, charts in sets.items():
-                for chart in charts.values():
-                    chart.visible = name == mode and runs == self.runs
+        shown = {self._key(name) for name in ("xb", "L", "e")}
+        for key, chart in self.chart_set.items():
+            if chart.visible != (key in shown):
+                chart.visible = key in shown
 
     def update(self, arrays: dict[str, np.ndarray]) -> bool:
         """Send the arrays (PLOT_SERIES of the session) to the shown charts; False if too few samples."""
@@ -182,12 +235,20 @@ class LivePlots:
             self.clear()  # a run restarted (reset, model, preset): its predecessor's curves must not stay
             return False
         self.empty = False
-        xb_on, xb_off = on_off(arrays, "xb")
-        L_on, L_off = on_off(arrays, "L")
-        shown = self.charts[self.mode]
-        shown["xb"].data = (t, _clean(xb_on * XB_UM_PER_MM), _clean(xb_off * XB_UM_PER_MM))
-        shown["L"].data = (t, _clean(L_on * L_MNS_PER_SI), _clean(L_off * L_MNS_PER_SI))
-        self.error.data = (t, _clean(arrays["ee_error"]))
+        curves = {"xb": on_off(arrays, "xb"), "L": on_off(arrays, "L"), "e": (arrays["ee_error"],)}
+        si_peaks = {name: _largest(cs) * SI_PER_BUFFER[name] for name, cs in curves.items()}
+        units = {name: display_unit(si_peaks[name], UNITS[name], self.units[name]) for name in curves}
+        if units != self.units:
+            self.units = units
+            self.show_mode(self.mode)
+        for name, cs in curves.items():
+            unit = self._key(name)[3]
+            scale = SI_PER_BUFFER[name] / dict(UNITS[name])[unit]  # buffer -> display unit
+            if not si_peaks[name] >= UNITS[name][0][1]:  # (below 1 nm or 1 nN·s: 0, as the readouts)
+                scale = 0.0
+            self.chart_set[self._key(name)].data = (t, *(_clean(c * scale) for c in cs))
+        xb_on, xb_off = curves["xb"]
+        L_on, L_off = curves["L"]
         e = peak(arrays["ee_error"]) * 1e-3  # m, the operated run's
         content = peaks_html(
             {
@@ -206,9 +267,15 @@ class LivePlots:
         if self.empty:
             return
         self.empty = True
-        for chart in (self.error, *(c for sets in self.chart_sets.values() for s in sets.values() for c in s.values())):
+        for chart in self.chart_set.values():
             chart.data = tuple(np.zeros(2) for _ in chart.data)
         self.peaks.content = peaks_html(None, self.sides)
+
+
+def _largest(curves: tuple[np.ndarray, ...]) -> float:
+    """The largest magnitude of the finite samples of ``curves``, NaN if there are none."""
+    peaks = [p for p in map(peak, curves) if math.isfinite(p)]
+    return max(peaks) if peaks else math.nan
 
 
 def _symlog(limits: tuple[float, float]) -> viser.uplot.Scale:

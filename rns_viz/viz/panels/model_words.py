@@ -22,7 +22,8 @@ def target_text(model: FsmsModel) -> str:
         )
     return (
         f"{drag}: the hand follows with reactionless end-effector control, Eq. (24); targets outside the "
-        "reactionless reachable set (lilac dots) are held at its nearest point."
+        "reactionless reachable set (the small lilac dots; the larger yellow-to-purple dots on it are the gain "
+        "explorer's authority) are held at its nearest point."
     )
 
 

@@ -26,6 +26,7 @@ from rns_viz.live.published.recording import Recording
 from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.panels.number_field import NumberField
 from rns_viz.viz.scene.player_export import PLAYER_URL, player_zip, scene_file
 from rns_viz.viz.scene.view_toggles import ViewToggles
 
@@ -50,7 +51,8 @@ class ReplayPanel:
         self._shown_version = -1
         gui = server.gui
         with gui.add_folder("Record and replay", expand_by_default=False):
-            self.seconds = gui.add_slider(
+            self.seconds = NumberField(
+                gui,
                 "Last N seconds (s)",
                 min=1.0,
                 max=MAX_RECORD_S,
@@ -58,13 +60,15 @@ class ReplayPanel:
                 initial_value=DEFAULT_SECONDS,
                 hint="How much of the run, up to now, to replay or export, in seconds of simulated time. The app "
                 "always keeps the last minute (it starts afresh at Reset, a preset or another model).",
+                bounded=True,  # read at the next replay or export
             )
             self.start = gui.add_button(
                 "Replay the last N s",
                 icon=viser.Icon.PLAYER_PLAY,
                 hint="Shows the last N seconds again in the scene and the plots; the simulation waits meanwhile.",
             )
-            self.timeline = gui.add_slider(
+            self.timeline = NumberField(
+                gui,
                 "Replay time t (s)",
                 min=0.0,
                 max=1.0,
@@ -72,6 +76,7 @@ class ReplayPanel:
                 initial_value=0.0,
                 disabled=True,
                 hint="Where the replay is, in seconds of simulated time (the time axis of the plots). Drag to scrub.",
+                bounded=False,  # the loop checks it is a time of the recording
             )
             self.play = gui.add_button(
                 "Pause replay",
@@ -80,13 +85,15 @@ class ReplayPanel:
                 hint="Pause or play the replay (from the start again at its end).",
             )
             lo, hi = REPLAY_SPEEDS
-            self.speed = gui.add_slider(
+            self.speed = NumberField(
+                gui,
                 "Replay speed (×)",
                 min=lo,
                 max=hi,
                 step=0.1,
                 initial_value=1.0,
                 hint="Recorded seconds shown per second of your time: 0.1× is ten times slower than it happened.",
+                bounded=False,
             )
             self.live = gui.add_button(
                 "Back to live",

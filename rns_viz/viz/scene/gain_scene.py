@@ -28,6 +28,11 @@ UNSTABLE_RGB = (90, 90, 90)  # hatched with UNSTABLE_HATCH
 UNSTABLE_HATCH = (200, 200, 200)
 MISSING_RGB = (235, 235, 235)  # no such mode (an empty arm group)
 NOW_COLOUR = (255, 255, 255)
+# viser's client turns an image's plane by pi about x, so its back faces the camera, and the outline it
+# draws on a hovered clickable node (back faces, yellow at 0.8 opacity) then covered the whole map: every
+# colour washed to yellow while the mouse was on it. Turned back, the plane's front faces the camera and
+# the outline shows only as a frame around the map.
+IMAGE_TURN = tuple(vtf.SO3.from_x_radians(math.pi).wxyz)
 PAPER_COLOUR = (20, 20, 20)
 # viridis at 0, 1/4, 1/2, 3/4, 1 (slow decay dark, fast decay yellow)
 _ANCHORS = np.array([[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]], dtype=float)
@@ -63,14 +68,17 @@ def map_rates(gain_map: GainMap, quantity: Quantity) -> np.ndarray:
 
 
 def map_image(gain_map: GainMap, quantity: Quantity) -> tuple[np.ndarray, tuple[float, float]]:
-    """RGB image (G*CELL_PIXELS, B*CELL_PIXELS, 3) of the map (g_m up, g_b right) and its colour scale."""
+    """RGB image (G*CELL_PIXELS, B*CELL_PIXELS, 3) of the map and its colour scale: column = g_b (left to
+    right), row = g_m (row 0 the highest), as :class:`GainScene` shows it (g_b right, g_m up)."""
     rates = map_rates(gain_map, quantity)
     scale = colour_scale(rates, gain_map.stable)
     rgb = colours(rates, scale)  # (B, G, 3)
     rgb[~np.isfinite(rates)] = MISSING_RGB
     hatch = np.zeros((CELL_PIXELS, CELL_PIXELS), dtype=bool)
     hatch[np.add.outer(np.arange(CELL_PIXELS), np.arange(CELL_PIXELS)) % CELL_PIXELS == 0] = True
-    cells = np.repeat(np.repeat(rgb.transpose(1, 0, 2)[::-1], CELL_PIXELS, 0), CELL_PIXELS, 1)  # row 0 = top g_m
+    # Row 0 is the highest g_m: the image node is turned by pi about x (IMAGE_TURN) back against viser's own
+    # turn of its plane, so row 0 is drawn at the map frame's +y, g_m up.
+    cells = np.repeat(np.repeat(rgb.transpose(1, 0, 2)[::-1], CELL_PIXELS, 0), CELL_PIXELS, 1)
     bad = np.repeat(np.repeat((~gain_map.stable).T[::-1], CELL_PIXELS, 0), CELL_PIXELS, 1)
     stripes = np.tile(hatch, (gain_map.g_m.size, gain_map.g_b.size))
     cells[bad] = UNSTABLE_RGB
@@ -125,7 +133,9 @@ class GainScene:
             visible=False,
         )
         blank = np.full((8, 8, 3), MISSING_RGB, dtype=np.uint8)
-        self.image = scene.add_image(self.IMAGE, blank, self.size, self.size, format="png", receive_shadow=False)
+        self.image = scene.add_image(
+            self.IMAGE, blank, self.size, self.size, format="png", receive_shadow=False, wxyz=IMAGE_TURN
+        )
         self.image.on_click(lambda event: self._clicked(event, on_point))
         mark = 0.018 * self.size
         self.now = scene.add_icosphere(self.NOW, radius=mark, color=NOW_COLOUR, visible=False)

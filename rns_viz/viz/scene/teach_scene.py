@@ -23,7 +23,7 @@ L_COLOUR = (120, 40, 170)  # purple: coupling momentum
 N_COLOUR = (235, 130, 0)  # orange: null-space direction at the hand
 OUTLINE_COLOUR = (110, 60, 190)  # the reachable region's edge, darker than its dots
 PATH_ARROWS = 8  # arrowheads along the current path
-L_REF_RATE = 1.0  # rad/s: a joint rate that draws L at full arrow length (with sigma(H_bm) at the start)
+L_REF_RATE = 1.0  # rad/s: a joint rate that draws L at full arrow length (with sigma_min(S H_bm) at the start)
 
 
 class TeachScene:

@@ -1,0 +1,131 @@
+"""Words on screen that must be true: controls named by the lessons exist under those names and are not
+disabled when a lesson names them, and one quantity has one notation everywhere it is shown.
+
+Lessons name a control in *italics*, exactly as the panel labels it (a folder may be named without its
+parenthesis: *Live plots* for 'Live plots (last 10 s)')."""
+
+from __future__ import annotations
+
+import ast
+import re
+from collections.abc import Iterator
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import pytest
+import viser
+
+import rns_viz
+from rns_viz.live.published.snapshot import LessonStatus
+from rns_viz.live.teaching import lessons, lessons_boom
+from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.viz.panels import lesson_panel
+from rns_viz.viz.server.app import RnsApp, start_app
+
+ROOT = Path(rns_viz.__file__).resolve().parent
+ITALIC = re.compile(r"(?<![*\w])\*(?!\*)([^*\n]+?)\*(?![*\w])")  # *name*, not **bold**
+# Any notation of a singular value of H_bm, and the one the app uses (with words first where it is named:
+# "distance to singularity"); sigma_min(...) in ASCII where a docstring names it.
+SIGMA_OF_HBM = re.compile(r"(σ|sigma)\S{0,20}?\(\s*(S\s*)?H(_|<sub>)?bm")
+NOTATIONS = ("σ_min(S H_bm", "σ<sub>min</sub>(S H<sub>bm", "sigma_min(S H_bm")
+
+
+@pytest.fixture(scope="module")
+def app() -> Iterator[RnsApp]:
+    app = start_app("trep", port=0, realtime=False, verbose=False)
+    yield app
+    app.stop()
+
+
+def controls(app: RnsApp) -> dict[str, list[Any]]:
+    """Every name a person can find in the panel -> the controls of that name: labels of buttons, boxes,
+    dropdowns and folders (also without a trailing parenthesis), and the options of button groups."""
+    gui = app.server.gui
+    names: dict[str, list[Any]] = {}
+    handles = [*gui._gui_input_handle_from_uuid.values(), *gui._container_handle_from_uuid.values()]  # (viser's)
+    for handle in handles:
+        label = getattr(handle, "label", None)
+        for name in (label, re.sub(r" \([^()]*\)$", "", label or "")):
+            if name:
+                names.setdefault(name, []).append(handle)
+        if isinstance(handle, viser.GuiButtonGroupHandle):
+            for option in handle.options:
+                names.setdefault(option, []).append(handle)
+    return names
+
+
+def progress_texts() -> list[str]:
+    """The constant parts of every Progress(...) message of the lessons (formatted values as {})."""
+    out = []
+    for module in (lessons, lessons_boom):
+        for node in ast.walk(ast.parse(Path(module.__file__).read_text())):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "Progress":
+                for arg in node.args:
+                    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+                        out.append(arg.value)
+                    elif isinstance(arg, ast.JoinedStr):
+                        out.append("".join(v.value if isinstance(v, ast.Constant) else "{}" for v in arg.values))
+    assert len(out) > 10
+    return out
+
+
+def lesson_texts() -> list[str]:
+    texts = [part for ls in LESSONS.values() for lesson in ls for part in (lesson.text, lesson.task)]
+    return [*texts, *progress_texts(), lesson_panel.NO_LESSON, lesson_panel.LAST_DONE]
+
+
+def test_every_control_a_lesson_names_is_in_the_panel_under_that_name(app: RnsApp) -> None:
+    names = controls(app)
+    named = {name for text in lesson_texts() for name in ITALIC.findall(text)}
+    assert {"Kick the base", "Same end points, joint space", "Start cyclic motion", "Next"} <= named
+    missing = sorted(name for name in named if name not in names)
+    assert not missing, f"lessons name controls the panel does not have: {missing}"
+
+
+def test_no_lesson_asks_for_a_disabled_control(app: RnsApp) -> None:
+    """Every lesson's text, done or not, as the panel shows it: each button it names is enabled."""
+    names = controls(app)
+    snap = app.session.snapshot()
+    states = [None] + [
+        LessonStatus(model, k, len(ls), lesson.title, lesson.equation, lesson.text, lesson.task, done, "…")
+        for model, ls in LESSONS.items()
+        for k, lesson in enumerate(ls, start=1)
+        for done in (False, True)
+    ]
+    for status in states:
+        app.lessons.refresh(replace(snap, lesson=status))
+        text = app.lessons.text.content
+        for name in ITALIC.findall(text):
+            for handle in names.get(name, []):
+                if isinstance(handle, viser.GuiButtonHandle):
+                    assert not handle.disabled, f"{status}: the text asks for {name!r}, which is disabled"
+    last = LESSONS["trep"][-1]
+    done = LessonStatus("trep", 6, 6, last.title, last.equation, last.text, last.task, True, "")
+    app.lessons.refresh(replace(snap, lesson=done))
+    assert app.lessons.next.disabled and "*Next*" not in app.lessons.text.content
+
+
+def shown_strings() -> Iterator[tuple[str, str]]:
+    """(where, text) of every string the app's panel, scene and lessons can show (the viz and live layers'
+    string constants) and of the docs."""
+    for path in sorted([*(ROOT / "viz").rglob("*.py"), *(ROOT / "live").rglob("*.py")]):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str):
+                yield f"{path.name}:{node.lineno}", node.value
+    for path in (ROOT.parent / "README.md", *sorted((ROOT.parent / "docs").glob("*.md"))):
+        yield path.name, path.read_text()
+
+
+def test_the_distance_to_singularity_has_one_notation() -> None:
+    found = [(where, text[m.start() : m.end()]) for where, text in shown_strings() for m in SIGMA_OF_HBM.finditer(text)]
+    assert len(found) >= 5
+    other = [(where, s) for where, s in found if not s.startswith(NOTATIONS)]
+    assert not other, f"other notations of sigma_min(S H_bm): {other}"
+
+
+def test_the_readout_names_it_in_words_first(app: RnsApp) -> None:
+    from rns_viz.viz.panels.panel_text import readouts_html
+
+    html = readouts_html(app.session.snapshot())
+    assert "distance to singularity σ<sub>min</sub>(S H<sub>bm</sub>)" in html
