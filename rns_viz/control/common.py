@@ -77,6 +77,16 @@ class ControlLaw(Protocol):
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput: ...
 
+    def sampled(self, t: float) -> bool:
+        """How the simulator applies this law over the step that starts at t.
+
+        True: a digital controller, its torque computed at t and held over the step (vibration
+        suppression, g_b in force). False: a joint servo on the measured state, evaluated wherever
+        the integrator evaluates the plant (every RK4 stage, its state and time): a held arm then stays
+        held and the base rings as the structure alone, not fed back by a torque half a step late.
+        """
+        ...
+
     def retune(self, gains: Gains) -> None:
         """New gains (and the null-space input's), from the next step on."""
         ...

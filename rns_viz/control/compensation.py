@@ -35,8 +35,8 @@ from rns_viz.profiles import quintic
 from rns_viz.rns import damped_pinv
 
 LIMIT_MARGIN = math.radians(30.0)  # rad: the limit term of the avoidance measure acts this close to a limit
-AVOID_EVERY = 10  # calls between evaluations of the avoidance gradient (a slow null-space drift; its
-# RNEA derivatives cost as much as the rest of the law); P_2 is applied to it at every call
+AVOID_EVERY_S = 0.01  # s between evaluations of the avoidance gradient (ten 1 ms steps; a slow null-space
+# drift, its RNEA derivatives cost as much as the rest of the law); P_2 is applied to it at every call
 
 
 @dataclass(frozen=True)
@@ -112,12 +112,17 @@ class CompensatingLaw:
         self._cols = m + self.comp  # compensator columns of M
         self._t = 0.0
         self._rehold = False
-        self._grad: np.ndarray | None = None  # the avoidance gradient in use, and calls since it was taken
-        self._grad_age = 0
+        self._grad: np.ndarray | None = None  # the avoidance gradient in use, and when it was taken (s)
+        self._grad_t = math.nan
 
     # -- ControlLaw protocol ------------------------------------------------------------------
     def retune(self, gains: Gains) -> None:
         self.gains = gains
+
+    def sampled(self, t: float) -> bool:
+        """A digital controller while it suppresses through the compensator (g_b in force); held or only
+        cancelling the reaction, a joint servo (see ControlLaw.sampled)."""
+        return self.compensate and self.suppress and self.gains.g_b != 0.0
 
     def set_suppression(self, on: bool) -> None:
         """Switch the G_b term (vibration suppression through the compensator) on or off."""
@@ -191,9 +196,8 @@ class CompensatingLaw:
         if self.compensate:
             g_b = g.g_b if self.suppress else 0.0
             y = g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g.g_m * cp.coupling_momentum - H1 @ acc1
-            if self._grad is None or self._grad_age >= AVOID_EVERY:
-                self._grad, self._grad_age = self.avoidance_gradient(q, H2), 0
-            self._grad_age += 1
+            if self._grad is None or not 0.0 <= t - self._grad_t < AVOID_EVERY_S - 1e-9:  # 1e-9 s: summed steps
+                self._grad, self._grad_t = self.avoidance_gradient(q, H2), t
             u2 = self.avoid_gain * self._grad - self.null_damping * thetadot2
             acc2 = inv2.inverse @ y + u2 - inv2.inverse @ (H2 @ u2)  # H_bm,2^+ y + P_2 u_2, Eqs. (9), (15)
         else:
