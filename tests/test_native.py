@@ -161,6 +161,21 @@ def test_law_agrees_at_random_states(name: str) -> None:
             law_agrees(model, law, q, v, t=RNG.uniform(0, 3))
 
 
+@pytest.mark.parametrize("selection", [(1, 1, 1, 1, 1, 1), (0, 0, 0, 0, 1, 1), (0, 0, 0, 0, 0, 1)])
+def test_law_agrees_with_weighted_moment_rows_where_it_damps(selection: tuple[int, ...]) -> None:
+    """boom7's moment rows weighted by 1/reach (rns.weighted_damped_pinv): six, two and one selected rows,
+    the damping threshold raised so that the damped inverse acts at every random state."""
+    model = FsmsModel.from_name("boom7").with_selection(selection)
+    assert model.coupling_weights is not None
+    for _ in range(10):
+        q = np.r_[RNG.normal(0, 1e-2, model.m), RNG.uniform(-math.pi, math.pi, model.n)]
+        v = RNG.normal(0, 1.0, model.nv)
+        for law in random_laws(model)[:3]:
+            law.coupling.threshold = law.coupling.max_damping = 50.0  # kg m: beyond sigma_min everywhere
+            assert law.coupling(q, v).inverse.damping > 0
+            law_agrees(model, law, q, v, t=RNG.uniform(0, 3))
+
+
 def test_law_agrees_at_the_trep_singularity() -> None:
     """Arm stretched along the base x axis: H_bm = 0, the damped inverse keeps both finite and equal."""
     model = FsmsModel.from_name("trep")

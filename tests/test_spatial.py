@@ -20,7 +20,7 @@ from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES, ModelFileError
 from rns_viz.paths import nearby_seeds, path_family, trace_paths
-from rns_viz.rns import check_integrability, null_vector
+from rns_viz.rns import check_integrability, null_vector, singularity_distance
 from rns_viz.scenarios import (
     ALL_SCENARIOS,
     BOOM7_DISPLACEMENT,
@@ -237,15 +237,32 @@ def test_spatial_presets_are_apart_from_the_apps(boom7: FsmsModel) -> None:
     assert (gains.g_b, gains.g_m) == (BOOM7_GAINS.g_b, BOOM7_GAINS.g_m)
 
 
-def test_damping_threshold_follows_sigma_min(boom7: FsmsModel) -> None:
-    """10 % of sigma_min(S H_bm(theta_0)): for one row that is |h| (TREP as before); boom7 is not damped."""
+def test_damping_threshold_follows_the_distance_to_singularity(boom7: FsmsModel) -> None:
+    """10 % of sigma_min(W S H_bm(theta_0)), the moment rows divided by the arm's reach: for one row that
+    is |h| (TREP as before); boom7 is not damped there (the norm would have damped it at every step)."""
     trep = FsmsModel.from_name("trep")
     h = trep.coupling_matrix(trep.q(trep.spec.default_configuration))
+    assert trep.coupling_weights is None
     assert CouplingEvaluator(trep).threshold == pytest.approx(0.1 * np.linalg.norm(h), rel=1e-12)
     H = boom7.coupling_matrix(boom7.q(boom7.spec.default_configuration))
-    sigma = np.linalg.svd(H, compute_uv=False)
+    W = np.diag(boom7.coupling_weights)
+    assert np.allclose(np.diag(W), [1, 1, 1, *[1 / boom7.arm_reach] * 3])
+    sigma = np.linalg.svd(W @ H, compute_uv=False)
     assert CouplingEvaluator(boom7).threshold == pytest.approx(0.1 * sigma[-1], rel=1e-12)
-    assert 0.1 * sigma[-1] < 0.01 * np.linalg.norm(H)  # what the norm would have given: 100x more
+    assert 0.1 * sigma[-1] < 0.01 * np.linalg.norm(W @ H)  # what the norm would have given: 100x more
+
+
+def test_the_distance_to_singularity_is_in_kg_m_whatever_the_unit_of_length(boom7: FsmsModel) -> None:
+    """Restated in millimetres, S H_bm's force rows (kg m) grow 1e3 times, its moment rows (kg m^2) 1e6
+    times and the reach 1e3 times: the weighted distance grows exactly 1e3 times (kg m -> kg mm), the
+    unweighted sigma_min of the mixed rows does not (its value depended on the unit chosen)."""
+    H = boom7.coupling_matrix(boom7.q(boom7.spec.default_configuration))
+    c = 1e3  # mm per m
+    H_mm = H * np.array([c, c, c, c * c, c * c, c * c])[:, None]
+    w_mm = np.array([1.0, 1.0, 1.0, *[1 / (c * boom7.arm_reach)] * 3])
+    assert singularity_distance(H_mm, w_mm) == pytest.approx(c * singularity_distance(H, boom7.coupling_weights))
+    unweighted = singularity_distance(H_mm) / singularity_distance(H)
+    assert abs(unweighted / c - 1) > 0.2
 
 
 def test_momentum_balance_with_the_boom_wrench_as_the_only_external_load(boom7: FsmsModel) -> None:

@@ -19,7 +19,8 @@ double smallest_singular_value(const MatrixXd& A) {
   return Eigen::JacobiSVD<MatrixXd>(A).singularValues()(std::min(A.rows(), A.cols()) - 1);
 }
 
-ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, const MatrixXd& K_b, const MatrixXd& D_b,
+ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, const VectorXd& row_weights,
+           const MatrixXd& K_b, const MatrixXd& D_b,
            const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot, const std::string& ee_frame,
            int base_joint, const std::vector<int>& task_rows)
     : model_(robot.model()),
@@ -30,6 +31,7 @@ ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, co
       base_joint_(base_joint),
       task_rows_(task_rows),
       rows_(rows),
+      weights_(row_weights),
       K_(K_b),
       D_(D_b),
       Dm_(D_m),
@@ -49,6 +51,8 @@ ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, co
     throw std::invalid_argument("K_b, D_b (m x m), D_m (n x n) and 1..m selected rows must fit the model");
   for (int i : rows)
     if (i < 0 || i >= m_) throw std::invalid_argument("a selected row is not a base row");
+  if (weights_.size() != r_ || !(weights_.array() > 0.0).all())
+    throw std::invalid_argument("one positive weight per selected row");
   if (base_joint < 1 || base_joint >= model.njoints) throw std::invalid_argument("the base joint is not in the model");
   for (int i : task_rows)
     if (i < 0 || i > 2) throw std::invalid_argument("task rows are 0 (x), 1 (y) or 2 (z)");
@@ -218,15 +222,17 @@ double ClosedLoop::coupling(const ConstRef& q, const ConstRef& v, Ref L) {
   L = H_bm_ * thetadot;
   pinv_.resize(n_, r_);
   double sigma;
-  if (r_ == 1) {
-    const double sigma2 = H_bm_.row(0).squaredNorm();
+  if (r_ == 1) {  // the column h w^2 / (w^2 |h|^2 + lambda^2)
+    const double w2 = weights_(0) * weights_(0);
+    const double sigma2 = w2 * H_bm_.row(0).squaredNorm();
     sigma = std::sqrt(sigma2);
-    pinv_.col(0) = H_bm_.row(0).transpose() / (sigma2 + damping_squared(sigma, threshold_, max_damping_));
-  } else {
-    sigma = smallest_singular_value(H_bm_);
+    pinv_.col(0) = H_bm_.row(0).transpose() * (w2 / (sigma2 + damping_squared(sigma, threshold_, max_damping_)));
+  } else {  // (W H)^T (W H (W H)^T + lambda^2 E)^-1 W
+    const MatrixXd WH = weights_.asDiagonal() * H_bm_;
+    sigma = smallest_singular_value(WH);
     const double lam2 = damping_squared(sigma, threshold_, max_damping_);
-    const MatrixXd A = H_bm_ * H_bm_.transpose() + lam2 * MatrixXd::Identity(r_, r_);
-    pinv_ = H_bm_.transpose() * A.partialPivLu().solve(MatrixXd::Identity(r_, r_));
+    const MatrixXd A = WH * WH.transpose() + lam2 * MatrixXd::Identity(r_, r_);
+    pinv_ = WH.transpose() * A.partialPivLu().solve(MatrixXd::Identity(r_, r_)) * weights_.asDiagonal();
   }
   return sigma;
 }

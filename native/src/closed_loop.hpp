@@ -21,8 +21,9 @@
 //     kernels of the reactionless-path tracer (rns_viz.paths.CouplingField):
 //     com_jacobians(m, thetas, J, com) and centers_of_mass(m, thetas, com) evaluate pinocchio's
 //     centre-of-mass Jacobian / position at K arm configurations (x_b = 0) in one call.
-//   ClosedLoop(robot, rows, K_b, D_b, D_m, threshold, max_damping, cb_is_hbm_dot, ee_frame,
-//     base_joint, task_rows). Each *_step (..., forces, dt, staged, x_next, tau, L) writes the next
+//   ClosedLoop(robot, rows, row_weights, K_b, D_b, D_m, threshold, max_damping, cb_is_hbm_dot, ee_frame,
+//     base_joint, task_rows): row_weights W weigh the selected rows of S H_bm into one unit (its moment
+//     rows divided by the arm's reach, rns_viz.rns.singularity_distance) for sigma_min and the damping. Each *_step (..., forces, dt, staged, x_next, tau, L) writes the next
 //     state, the torque and the coupling momentum at the step's start into the given float64
 //     arrays and returns sigma_min(S H_bm) (FloatingPointError when they are not finite); its
 //     time-varying inputs, g_b and the reference (theta_r, ..., or x_d, ...), hold one sample, or
@@ -101,7 +102,8 @@ class RobotModel {
 
 class ClosedLoop {
  public:
-  ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, const MatrixXd& K_b, const MatrixXd& D_b,
+  ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, const VectorXd& row_weights, const MatrixXd& K_b,
+             const MatrixXd& D_b,
              const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot, const std::string& ee_frame,
              int base_joint, const std::vector<int>& task_rows);
 
@@ -161,8 +163,8 @@ class ClosedLoop {
                const StageLaw* law = nullptr);
 
   // M, c = (c_b, c_m), H_bm' theta' (rns_viz.model.FsmsModel.dynamics), the selected rows S and the
-  // damped H_bm^+ (rns_viz.rns.damped_pinv; closed form for one row). Writes L = S H_bm theta',
-  // Eq. (8); returns sigma_min(S H_bm).
+  // damped H_bm^+ = (W S H_bm)^+ W (rns_viz.rns.weighted_damped_pinv; closed form for one row). Writes
+  // L = S H_bm theta', Eq. (8); returns sigma_min(W S H_bm).
   double coupling(const ConstRef& q, const ConstRef& v, Ref L);
 
   // Eq. (15): theta'' = H_bm^+ (H_b G_b x_b' - H_bm' theta' - G_m L) + P u, P u = u - H_bm^+ (H_bm u).
@@ -188,6 +190,7 @@ class ClosedLoop {
   int ee_frame_, base_joint_;
   std::vector<int> task_rows_;
   std::vector<int> rows_;
+  VectorXd weights_;  // W over the selected rows
   MatrixXd K_, D_, Dm_;
   double threshold_, max_damping_;
   bool cb_is_hbm_dot_, arm_damped_ = false;

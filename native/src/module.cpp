@@ -37,8 +37,9 @@ NB_MODULE(_core, mod) {
       .def("com_jacobians", &RobotModel::com_jacobians)
       .def("centers_of_mass", &RobotModel::centers_of_mass);
   nb::class_<ClosedLoop>(mod, "ClosedLoop")
-      .def(nb::init<const RobotModel&, const std::vector<int>&, const MatrixXd&, const MatrixXd&, const MatrixXd&, double,
-                    double, bool, const std::string&, int, const std::vector<int>&>())
+      .def(nb::init<const RobotModel&, const std::vector<int>&, const rns_native::VectorXd&, const MatrixXd&,
+                    const MatrixXd&, const MatrixXd&, double, double, bool, const std::string&, int,
+                    const std::vector<int>&>())
       .def("damped_control", &ClosedLoop::damped_control)
       .def("damped_step", &ClosedLoop::damped_step)
       .def("tracking_control", &ClosedLoop::tracking_control)

@@ -25,6 +25,7 @@ from rns_viz.control import ControlOutput, Gains, TaskSample
 from rns_viz.control.compensation import CompensatingLaw
 from rns_viz.live.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
+from rns_viz.rns import singularity_distance
 
 WORKSPACE_MARGIN = 0.03  # fraction of the task arm's reach kept clear of its outer and inner boundary
 CANCEL_FLOOR = 1e-4  # kg m/s: below this task-arm momentum there is nothing to cancel
@@ -132,11 +133,12 @@ class TaskTarget(SmoothedTarget):
 
 
 def compensator_sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:
-    """S H_bm, sigma_min(S H_bm,2) of the compensator, sigma_min(J_1) of the task arm, the RNS dimension."""
+    """S H_bm, the compensator's distance to singularity sigma_min(W S H_bm,2) (kg m, rns.singularity_distance),
+    sigma_min(J_1) of the task arm, the RNS dimension."""
     H = model.mass_matrix(model.q(theta))[model.selected, model.m :]
     comp, task = model.arm_groups["compensating"].index, model.arm_groups["task"].index
     J1 = model.ee_jacobian(theta)[:, task]
-    sigma_2 = float(np.linalg.svd(H[:, comp], compute_uv=False)[-1])
+    sigma_2 = float(singularity_distance(H[:, comp], model.coupling_weights))
     return H, sigma_2, float(np.linalg.svd(J1, compute_uv=False)[-1]), model.n - H.shape[0]
 
 

@@ -97,6 +97,7 @@ class NativeStep:
         self._core = _native.core.ClosedLoop(  # type: ignore[union-attr]
             robot,
             [int(i) for i in model.selected],
+            np.ones(len(model.selected)) if model.coupling_weights is None else model.coupling_weights,
             np.ascontiguousarray(model.K_b, dtype=float),
             np.ascontiguousarray(model.D_b, dtype=float),
             np.ascontiguousarray(model.D_m, dtype=float),

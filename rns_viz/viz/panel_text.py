@@ -80,7 +80,8 @@ def readouts_html(snap: Snapshot) -> str:
         (
             "σ<sub>min</sub>(H<sub>bm</sub>)",
             _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
-            "how much grip the arm has on the base; near 0 it can neither push nor damp it",
+            "distance to singularity: how much grip the arm has on the base, near 0 it can neither push nor damp "
+            "it; kg·m, a turning base's moment rows (kg·m²) divided by the arm's reach",
         ),
         (
             "σ(J̄)",
