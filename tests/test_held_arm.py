@@ -6,8 +6,9 @@ base does: with the arm at rest on its reference the arm is rigid, and the base 
 locked H_b(theta_0) alone (rns_viz.analysis.locked). Each simulated mode is projected out of the logged
 (x_b, x_b') with the locked modes' left eigenvectors and fitted by one complex exponential. A servo
 torque held over the 1 ms step fed the base state back half a step late and failed these checks
-(boom7: zeta 0.451 % instead of 0.500 % in the first mode, 4.71 % instead of 3.38 % in torsion; TREP,
-which has no base damping, gained 0.12 % of its energy in 8 s under fig10-off's held servo).
+(boom7 with its earlier lumped tip mass: zeta 0.451 % instead of 0.500 % in the first mode, 4.71 %
+instead of 3.38 % in torsion; TREP, which has no base damping, gained 0.12 % of its energy in 8 s
+under fig10-off's held servo).
 """
 
 from __future__ import annotations
