@@ -94,8 +94,10 @@ def weighted_damped_pinv(
         w = float(weights[0])
         scaled = damped_row_pinv([w * a for a in A[0].tolist()], threshold, max_damping)
         return DampedInverse(None, scaled.sigma_min, scaled.damping, A[0].tolist(), w * w * scaled.row_scale)  # type: ignore[operator]
-    scaled = damped_pinv(A * weights[:, None], threshold, max_damping)
-    return DampedInverse(scaled.inverse * weights, scaled.sigma_min, scaled.damping)
+    if A.shape[0] == 2:
+        scaled = damped_pinv(A * weights[:, None], threshold, max_damping)
+        return DampedInverse(scaled.inverse * weights, scaled.sigma_min, scaled.damping)
+    return _any_rows(A * weights[:, None], threshold, max_damping, weights)
 
 
 def singularity_distance(A: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray | float:
@@ -134,13 +136,16 @@ def _damping_squared(sigma: float, threshold: float, max_damping: float) -> floa
     return (1.0 - (sigma / threshold) ** 2) * max_damping**2
 
 
-def _any_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
-    """Any number of rows: sigma_min from the SVD, then a solve with A A^T + lambda^2 E."""
-    E = _identity(A.shape[0])
+def _any_rows(A: np.ndarray, threshold: float, max_damping: float, weights: np.ndarray | None = None) -> DampedInverse:
+    """Any number of rows: sigma_min from the SVD, then A^T G^-1 = (G^-1 A)^T with G = A A^T + lambda^2 E
+    symmetric (one solve). ``weights`` (A = W B already weighted): (G^-1 A)^T W, B's weighted inverse."""
     sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
     lam2 = _damping_squared(sigma, threshold, max_damping)
-    G = A @ A.T + lam2 * E
-    inverse = A.T @ np.linalg.solve(G, E)
+    G = A @ A.T
+    if lam2:
+        G += lam2 * _identity(A.shape[0])
+    solved = np.linalg.solve(G, A)
+    inverse = (solved if weights is None else solved * weights[:, None]).T
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 
