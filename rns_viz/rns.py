@@ -97,7 +97,8 @@ def weighted_damped_pinv(
     if A.shape[0] == 2:
         scaled = damped_pinv(A * weights[:, None], threshold, max_damping)
         return DampedInverse(scaled.inverse * weights, scaled.sigma_min, scaled.damping)
-    return _any_rows(A * weights[:, None], threshold, max_damping, weights)
+    column = weights[:, None]
+    return _any_rows(A * column, threshold, max_damping, column)
 
 
 def singularity_distance(A: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray | float:
@@ -138,14 +139,14 @@ def _damping_squared(sigma: float, threshold: float, max_damping: float) -> floa
 
 def _any_rows(A: np.ndarray, threshold: float, max_damping: float, weights: np.ndarray | None = None) -> DampedInverse:
     """Any number of rows: sigma_min from the SVD, then A^T G^-1 = (G^-1 A)^T with G = A A^T + lambda^2 E
-    symmetric (one solve). ``weights`` (A = W B already weighted): (G^-1 A)^T W, B's weighted inverse."""
+    symmetric (one solve). ``weights`` (a column, A = W B already weighted): (G^-1 A)^T W, B's weighted inverse."""
     sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
     lam2 = _damping_squared(sigma, threshold, max_damping)
     G = A @ A.T
     if lam2:
         G += lam2 * _identity(A.shape[0])
     solved = np.linalg.solve(G, A)
-    inverse = (solved if weights is None else solved * weights[:, None]).T
+    inverse = (solved if weights is None else solved * weights).T
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 

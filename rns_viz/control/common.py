@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import operator
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Literal, NamedTuple, Protocol
 
 import numpy as np
@@ -68,7 +68,7 @@ class ControlOutput:
     sigma_jbar: float = math.nan  # distance to singularity of J-bar (tracking laws)
     theta_ref: np.ndarray | None = None  # (n,) rad
     ee_ref: np.ndarray | None = None  # (p,) m, base frame
-    extra: dict[str, float] = field(default_factory=dict)
+    extra: dict[str, float] | None = None  # a law's own extra outputs (None: none)
 
 
 class ControlLaw(Protocol):

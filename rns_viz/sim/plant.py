@@ -45,7 +45,7 @@ class Plant:
         self._stage_x = [row[: 2 * nv] for row in self._stages]
         self._stage_k = [row[nv:] for row in self._stages]
         self._slopes = self._stages[:, nv:]  # (4, 2 nv): k_1 .. k_4
-        self._weights_dt = (0.0, RK4_WEIGHTS * 0.0)  # (dt, b_i dt), cached
+        self._weights_dt = (0.0, RK4_WEIGHTS * 0.0, (0.0, 0.0, 0.0, None))  # (dt, b_i dt, stage steps), cached
 
     def hold(self, tau: np.ndarray, f_ext: np.ndarray | None) -> None:
         """Set the joint torques and base force used by :meth:`held_acceleration`."""
@@ -104,7 +104,10 @@ class Plant:
         sampled = isinstance(f_ext, tuple)
         self.hold(tau, f_ext[0] if sampled else f_ext)  # type: ignore[index, arg-type]
         if self._scalar_base:
-            return self._rk4_scalar_base(x, f_ext if sampled else None, dt, torque_at)  # type: ignore[arg-type]
+            samples = f_ext if sampled else None
+            if torque_at is not None:  # a servo at every stage: the general stages, the torque set per stage
+                return self._rk4_staged_scalar_base(x, samples, dt, torque_at)  # type: ignore[arg-type]
+            return self._rk4_scalar_base(x, samples, dt)  # type: ignore[arg-type]
         q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
         xs[0][:] = x
         for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
@@ -115,20 +118,16 @@ class Plant:
             if torque_at is not None:
                 self._set_torque(torque_at(c, q[s + 1], v[s + 1]))
         a[3][:] = self.held_acceleration(q[3], v[3])
-        return x + self._weights(dt).dot(self._slopes)
+        return x + self._weights(dt)[0].dot(self._slopes)
 
     def _set_torque(self, tau: np.ndarray) -> None:
         self._tau = tau
         self._u[self._m :] = tau
 
-    def _rk4_scalar_base(
-        self, x: np.ndarray, samples: StageForces | None, dt: float, torque_at: StageTorque | None = None
-    ) -> np.ndarray:
+    def _rk4_scalar_base(self, x: np.ndarray, samples: StageForces | None, dt: float) -> np.ndarray:
         """:meth:`rk4_state_step` for a 1-DOF base, inputs set by :meth:`hold`: the same stages, with
         :meth:`held_acceleration`'s base force -k x_b - d x_b' + f as a number written inline and
         everything it reads bound once (four stages per control step; TREP, the 3R, arm7)."""
-        if torque_at is not None:  # a servo at every stage: the general stages, the torque set per stage
-            return self._rk4_staged_scalar_base(x, samples, dt, torque_at)
         q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
         aba, pin_model, data, u, add = pin.aba, self._pin_model, self._data, self._u, np.add
         k_b, d_b, tau, D_m, damped = self._k, self._d, self._tau, self._Dm, self._arm_damped
@@ -139,7 +138,8 @@ class Plant:
             f_mid, f_end = (0.0 if g is None else float(g[0]) for g in samples[1:])
             forces = (f, f_mid, f_mid, f_end)
         xs[0][:] = x
-        for s, c in enumerate((0.5 * dt, 0.5 * dt, dt, None)):
+        weights, steps = self._weights(dt)
+        for s, c in enumerate(steps):
             q_s, v_s = q[s], v[s]
             u[0] = -k_b * q_s.item(0) - d_b * v_s.item(0) + forces[s]
             if damped:
@@ -147,7 +147,7 @@ class Plant:
             a[s][:] = aba(pin_model, data, q_s, v_s, u)
             if c is not None:
                 add(x, c * k[s], xs[s + 1])
-        return x + self._weights(dt).dot(self._slopes)
+        return x + weights.dot(self._slopes)
 
     def _rk4_staged_scalar_base(
         self, x: np.ndarray, samples: StageForces | None, dt: float, torque_at: StageTorque
@@ -164,12 +164,13 @@ class Plant:
                 self._set_force(forces[s // 2 + 1])
             self._set_torque(torque_at(c, q[s + 1], v[s + 1]))
         a[3][:] = self.held_acceleration(q[3], v[3])
-        return x + self._weights(dt).dot(self._slopes)
+        return x + self._weights(dt)[0].dot(self._slopes)
 
-    def _weights(self, dt: float) -> np.ndarray:
+    def _weights(self, dt: float) -> tuple[np.ndarray, tuple[float, float, float, None]]:
+        """b_i dt and the stage steps (dt/2, dt/2, dt, None: after the last stage), cached for dt."""
         if self._weights_dt[0] != dt:
-            self._weights_dt = (dt, RK4_WEIGHTS * dt)
-        return self._weights_dt[1]
+            self._weights_dt = (dt, RK4_WEIGHTS * dt, (0.5 * dt, 0.5 * dt, dt, None))
+        return self._weights_dt[1], self._weights_dt[2]
 
     def semi_implicit_euler_step(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None, dt: float

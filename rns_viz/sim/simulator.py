@@ -129,7 +129,8 @@ class Simulator:
     def step(self) -> ControlOutput:
         """Compute the control at t, advance the state by dt, log the step; returns the control."""
         t, x, dt = self.t, self._x, self.dt
-        forces = stage_forces(self.force, t, dt)  # at t, t + dt/2, t + dt
+        force = self.force
+        forces = None if type(force) is NoForce else stage_forces(force, t, dt)  # at t, t + dt/2, t + dt
         f = None if forces is None else forces[0]
         staged = not (self.hold_control and self._sampled(t))  # the law at every RK4 stage
         try:  # law and RK4 in one C++ call, which checks finiteness (None: the law is Python's)
@@ -147,7 +148,10 @@ class Simulator:
                 x_next = self.plant.rk4_state_step(x, out.tau, forces, dt, at_stage)
             else:
                 x_next = np.concatenate(self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt))
-            if not _all_finite(x_next, out.tau):
+            # no inf or NaN in x or tau: their sum of squares is finite (one number to test; entries
+            # beyond 1e154, where it overflows, mean a diverged run too)
+            tau = out.tau
+            if not math.isfinite(x_next.dot(x_next) + tau.dot(tau)):
                 raise SimulationDiverged(_DIVERGED.format(t=t))
         self._layout.write(self.log.next_row(), t, x, out, f)
         self._x, self.t = x_next, t + dt
@@ -178,9 +182,3 @@ class Simulator:
 
 def _always_sampled(t: float) -> bool:
     return True
-
-
-def _all_finite(x: np.ndarray, tau: np.ndarray) -> bool:
-    """No inf or NaN in x or tau: their sum of squares is finite (one number to test; entries beyond
-    1e154, where it overflows, mean a diverged run too)."""
-    return math.isfinite(x.dot(x) + tau.dot(tau))
