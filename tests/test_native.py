@@ -7,7 +7,10 @@ mid-run agree to 1e-12, and so do the paper's presets run both ways; the laws al
 states, at the TREP singularity, for a 2-DOF base with one or both rows selected (the SVD branch)
 and with gravity (the Coriolis branch of H_bm' theta'). Eq. (24) tracking is compared on the 3R (a
 2-D RNS) and on the 2-DOF base; the path tracer's centre-of-mass kernels against pinocchio's Python
-calls. Skipped when the module is not installed, unless RNS_VIZ_REQUIRE_NATIVE=1 (CI's native job):
+calls. Steps that evaluate the law at every RK4 stage (a joint servo, a law without g_b, continuous-time
+control; g_b and the reference at the stage times) agree with Python's on the 3R and boom7, and the
+damped inverse of boom7's weighted moment rows where it damps. Skipped when the module is not
+installed, unless RNS_VIZ_REQUIRE_NATIVE=1 (CI's native job):
 then a missing or unusable module fails.
 """
 
