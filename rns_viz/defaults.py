@@ -27,8 +27,8 @@ task arm to cancel it, then turns at 1-2 rad/s, far below its joints' URDF veloc
 
 boom7 (the spatial model): law (15) with g_b = 10, G_m = 2 on all six
 tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
-about 1.3 mm of a 4 m boom, drawn 50x). Its kick needs a direction: along the first base
-coordinate alone it would push the stiff axial mode (170 Hz, 1e-7 m).
+about 1.5 mm of a 4 m boom with the arm held, drawn 50x). Its kick needs a direction: along the first
+base coordinate alone it would push the stiff axial mode (157 Hz, 1e-7 m).
 """
 
 from __future__ import annotations

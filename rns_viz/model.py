@@ -103,6 +103,12 @@ class FsmsModel:
         # per base coordinate: a rotation (a revolute base joint: rad, N m) or not
         joints = model.joints
         self.base_rotational = tuple(joints[i].shortname().startswith("JointModelR") for i in range(1, self.m + 1))
+        self.arm_reach = self._arm_reach()
+        # S H_bm's rows in one unit: a moment row (kg m^2, a revolute base coordinate) divided by the arm's
+        # reach, so sigma_min(W S H_bm) is a distance in kg m (rns.singularity_distance); None: all kg m
+        turning = np.array([self.base_rotational[i] for i in self.selected], dtype=bool)
+        weights = np.where(turning, 1.0 / self.arm_reach, 1.0)
+        self.coupling_weights: np.ndarray | None = weights if turning.any() else None
         # c_b = H_bm' theta' exactly (M does not depend on x_b): see dynamics()
         self.cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
         # ee_kinematics: its buffers, the task rows as a slice where they are contiguous, and
@@ -114,6 +120,14 @@ class FsmsModel:
         self._base_axes_fixed = self.base_is_translational and bool(
             np.array_equal(self._base_rotation_at(np.zeros(model.nq)), np.eye(3))
         )
+
+    def _arm_reach(self) -> float:
+        """The arm's reach, m: its joint-to-joint distances plus the end-effector offset (pinocchio's joint
+        placements; the arm stretched). boom7's 1.09 m, TREP's 0.2 m, the 3R's 3 m."""
+        model = self.pin_model
+        joints = range(self.m + 2, model.njoints)
+        links = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in joints)
+        return links + float(np.linalg.norm(model.frames[self.ee_frame_id].placement.translation))
 
     def _base_rotation_at(self, q: np.ndarray) -> np.ndarray:
         data = self.pin_model.createData()

@@ -15,7 +15,7 @@ import pinocchio as pin
 
 from rns_viz import _native
 from rns_viz.model import FsmsModel
-from rns_viz.rns import null_vector
+from rns_viz.rns import null_vector, singularity_distance
 
 TWO_PI = 2.0 * np.pi
 MAX_TURN = 0.15  # rad the tangent may turn in one step; steps shrink on tight loops
@@ -348,7 +348,8 @@ def reactionless_reachable_set(
     Breadth-first over a joint-space lattice of cell ``spacing`` (rad): from every sample, step
     +-spacing along an orthonormal basis of N(S H_bm), project back onto the level set of the
     potential (Newton along H_bm, as the path tracer does), keep samples inside the joint limits
-    whose sigma_min(S H_bm) exceeds ``singular_sigma`` (kg m), and drop those in a visited cell.
+    whose distance to singularity (rns.singularity_distance) exceeds ``singular_sigma`` (kg m), and drop
+    those in a visited cell.
     Needs a translating base, where the RNS distribution is integrable (Eq. 26).
     """
     if not model.base_is_translational:
@@ -375,7 +376,7 @@ def reactionless_reachable_set(
         candidates = field.project(candidates, np.broadcast_to(level, (len(candidates), r)).copy())
         H_c, pot = field.rows_at(candidates, want_potential=True)
         ok = np.abs(pot - level).max(axis=1) < 1e-9 * max(1.0, float(np.abs(level).max()))
-        ok &= np.linalg.svd(H_c, compute_uv=False)[:, -1] > singular_sigma
+        ok &= singularity_distance(H_c, model.coupling_weights) > singular_sigma
         ok &= np.all(periodic | ((candidates >= model.lower) & (candidates <= model.upper)), axis=1)
         new = []
         for th in candidates[ok]:

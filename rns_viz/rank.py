@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.model import FsmsModel
+from rns_viz.rns import singularity_distance
 
 
 @dataclass(frozen=True)
@@ -27,13 +28,15 @@ class RankLoss:
 
     theta: np.ndarray  # (K, n) full joint configurations, rad, angles of ``columns`` in (-pi, pi]
     ee: np.ndarray  # (K, 3) end-effector positions in the base frame, m
-    sigma_min: np.ndarray  # (K,) smallest singular value of S H_bm[:, columns] there, kg m (kg m^2)
-    scale: float  # largest sigma_max of S H_bm[:, columns] on the search grid: the most coupled direction
+    sigma_min: np.ndarray  # (K,) sigma_min(W S H_bm[:, columns]) there, kg m (rns.singularity_distance)
+    scale: float  # largest sigma_max of W S H_bm[:, columns] on the search grid: the most coupled direction
     columns: np.ndarray  # indices into theta of the joints searched
 
 
 def _coupling(model: FsmsModel, theta: np.ndarray, columns: np.ndarray) -> np.ndarray:
-    return model.coupling_matrix(model.q(theta))[:, columns]
+    """W S H_bm[:, columns]: the moment rows divided by the arm's reach (rns.singularity_distance), kg m."""
+    H = model.coupling_matrix(model.q(theta))[:, columns]
+    return H if model.coupling_weights is None else H * model.coupling_weights[:, None]
 
 
 def _residual(model: FsmsModel, theta: np.ndarray, columns: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -110,7 +113,7 @@ def kernel_coupling(model: FsmsModel, theta: np.ndarray, columns: Sequence[int] 
     """|S H_bm v| for a unit joint velocity v along the kernel of S H_bm[:, columns], and sigma_max there.
 
     The kernel direction is the right singular vector of the smallest singular value (any direction
-    where the matrix vanishes). kg m (kg m^2) per rad/s.
+    where the matrix vanishes). Rows weighted as :func:`rns_viz.rns.singularity_distance`: kg m per rad/s.
     """
     cols = np.arange(model.n) if columns is None else np.asarray(columns, dtype=int)
     A = _coupling(model, np.asarray(theta, dtype=float), cols)
@@ -124,8 +127,8 @@ def sigma_grid(
     """sigma_min(S H_bm) on a grid of two joints over [-pi, pi] (others at ``theta``, default: the model's
     default configuration), for the joint-space inset.
 
-    Returns the two axes (rad) and sigma_min (points_per_joint, points_per_joint), kg m (kg m^2);
-    rank deficiency is its zero level.
+    Returns the two axes (rad) and sigma_min(W S H_bm) (points_per_joint, points_per_joint), kg m
+    (rns.singularity_distance); rank deficiency is its zero level.
     """
     cols = np.asarray(columns, dtype=int)
     if cols.size != 2:
@@ -136,5 +139,5 @@ def sigma_grid(
     for i, a in enumerate(axis):
         for j, b in enumerate(axis):
             theta[cols] = (a, b)
-            field[i, j] = np.linalg.svd(model.coupling_matrix(model.q(theta)), compute_uv=False)[-1]
+            field[i, j] = singularity_distance(model.coupling_matrix(model.q(theta)), model.coupling_weights)
     return axis, axis.copy(), field

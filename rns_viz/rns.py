@@ -78,6 +78,41 @@ def damped_pinv(
     return _any_rows(A, threshold, max_damping)
 
 
+def weighted_damped_pinv(
+    A: np.ndarray,
+    weights: np.ndarray | None,
+    threshold: float = DEFAULT_THRESHOLD,
+    max_damping: float = DEFAULT_MAX_DAMPING,
+) -> DampedInverse:
+    """:func:`damped_pinv` of A with its rows weighted, (W A)^+ W with W = diag(weights): sigma_min and the
+    damping are W A's, in the one unit the weights give every row (S H_bm's moment rows, kg m^2, divided
+    by a length: :func:`singularity_distance`). Undamped it is A's own right inverse (row weights do not
+    change it at full row rank); ``weights`` None: :func:`damped_pinv`."""
+    if weights is None:
+        return damped_pinv(A, threshold, max_damping)
+    if A.shape[0] == 1:  # one row: w a, and the column a w^2 / (w^2 |a|^2 + lambda^2)
+        w = float(weights[0])
+        scaled = damped_row_pinv([w * a for a in A[0].tolist()], threshold, max_damping)
+        return DampedInverse(None, scaled.sigma_min, scaled.damping, A[0].tolist(), w * w * scaled.row_scale)  # type: ignore[operator]
+    if A.shape[0] == 2:
+        scaled = damped_pinv(A * weights[:, None], threshold, max_damping)
+        return DampedInverse(scaled.inverse * weights, scaled.sigma_min, scaled.damping)
+    column = weights[:, None]
+    return _any_rows(A * column, threshold, max_damping, column)
+
+
+def singularity_distance(A: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray | float:
+    """sigma_min(W A): how far A (r x k, or a stack (..., r, k)) is from losing rank, with its rows
+    weighted into one unit (W = diag(weights); None: A's own rows). For S H_bm the model's
+    ``coupling_weights`` divide the moment rows (kg m^2) by the arm's length, so the distance is in kg m
+    whatever the rows (an unweighted sigma_min of rows in kg m and kg m^2 would change with the unit)."""
+    A = np.asarray(A, dtype=float)
+    if weights is not None:
+        A = A * weights[:, None]
+    sigma = np.linalg.svd(A, compute_uv=False)[..., -1]
+    return float(sigma) if sigma.ndim == 0 else sigma
+
+
 def truncated_inverse(A: np.ndarray, rank: int, threshold: float) -> DampedInverse:
     """A^+ of a wide matrix of rank ``rank`` at most (fewer than its rows): inverted on the span of its
     ``rank`` largest singular values, damped below ``threshold``; sigma_min is the rank-th singular
@@ -102,13 +137,16 @@ def _damping_squared(sigma: float, threshold: float, max_damping: float) -> floa
     return (1.0 - (sigma / threshold) ** 2) * max_damping**2
 
 
-def _any_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInverse:
-    """Any number of rows: sigma_min from the SVD, then a solve with A A^T + lambda^2 E."""
-    E = _identity(A.shape[0])
+def _any_rows(A: np.ndarray, threshold: float, max_damping: float, weights: np.ndarray | None = None) -> DampedInverse:
+    """Any number of rows: sigma_min from the SVD, then A^T G^-1 = (G^-1 A)^T with G = A A^T + lambda^2 E
+    symmetric (one solve). ``weights`` (a column, A = W B already weighted): (G^-1 A)^T W, B's weighted inverse."""
     sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
     lam2 = _damping_squared(sigma, threshold, max_damping)
-    G = A @ A.T + lam2 * E
-    inverse = A.T @ np.linalg.solve(G, E)
+    G = A @ A.T
+    if lam2:
+        G += lam2 * _identity(A.shape[0])
+    solved = np.linalg.solve(G, A)
+    inverse = (solved if weights is None else solved * weights).T
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 
 

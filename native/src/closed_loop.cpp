@@ -19,7 +19,8 @@ double smallest_singular_value(const MatrixXd& A) {
   return Eigen::JacobiSVD<MatrixXd>(A).singularValues()(std::min(A.rows(), A.cols()) - 1);
 }
 
-ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, const MatrixXd& K_b, const MatrixXd& D_b,
+ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, const VectorXd& row_weights,
+           const MatrixXd& K_b, const MatrixXd& D_b,
            const MatrixXd& D_m, double threshold, double max_damping, bool cb_is_hbm_dot, const std::string& ee_frame,
            int base_joint, const std::vector<int>& task_rows)
     : model_(robot.model()),
@@ -30,6 +31,7 @@ ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, co
       base_joint_(base_joint),
       task_rows_(task_rows),
       rows_(rows),
+      weights_(row_weights),
       K_(K_b),
       D_(D_b),
       Dm_(D_m),
@@ -49,6 +51,8 @@ ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, co
     throw std::invalid_argument("K_b, D_b (m x m), D_m (n x n) and 1..m selected rows must fit the model");
   for (int i : rows)
     if (i < 0 || i >= m_) throw std::invalid_argument("a selected row is not a base row");
+  if (weights_.size() != r_ || !(weights_.array() > 0.0).all())
+    throw std::invalid_argument("one positive weight per selected row");
   if (base_joint < 1 || base_joint >= model.njoints) throw std::invalid_argument("the base joint is not in the model");
   for (int i : task_rows)
     if (i < 0 || i > 2) throw std::invalid_argument("task rows are 0 (x), 1 (y) or 2 (z)");
@@ -56,6 +60,8 @@ ClosedLoop::ClosedLoop(const RobotModel& robot, const std::vector<int>& rows, co
   u_.setZero(nv_);
   stage_.setZero(2 * nv_);
   slope_sum_.setZero(2 * nv_);
+  stage_tau_.setZero(n_);
+  stage_L_.setZero(r_);
 }
 
 // Eq. (15) with u = -g_u theta'.
@@ -65,10 +71,14 @@ double ClosedLoop::damped_control(const ConstRef& x, double g_b, double g_m, dou
   return composite(x, g_b, g_m, 0.0, g_u, nullptr, tau, L);
 }
 
-double ClosedLoop::damped_step(const ConstRef& x, double g_b, double g_m, double g_u, const ConstRef& forces, double dt,
-                   Ref x_next, Ref tau, Ref L) {
-  const double sigma = damped_control(x, g_b, g_m, g_u, tau, L);
-  advance(x, tau, forces, dt, x_next);
+double ClosedLoop::damped_step(const ConstRef& x, const ConstRef& g_b, double g_m, double g_u, const ConstRef& forces, double dt,
+                   bool staged, Ref x_next, Ref tau, Ref L) {
+  const auto gain = [&](Index k) { return stage_sample(g_b, k, 1)(0); };
+  const double sigma = damped_control(x, gain(0), g_m, g_u, tau, L);
+  const StageLaw law = [&](Index k, const ConstRef& x_s, Ref tau_s, Ref L_s) {
+    damped_control(x_s, gain(k), g_m, g_u, tau_s, L_s);
+  };
+  advance(x, tau, forces, dt, x_next, staged ? &law : nullptr);
   return sigma;
 }
 
@@ -82,11 +92,17 @@ double ClosedLoop::tracking_control(const ConstRef& x, double g_b, double g_m, d
   return composite(x, g_b, g_m, k_p, k_d, &ref, tau, L);
 }
 
-double ClosedLoop::tracking_step(const ConstRef& x, double g_b, double g_m, double k_p, double k_d, const ConstRef& theta_r,
+double ClosedLoop::tracking_step(const ConstRef& x, const ConstRef& g_b, double g_m, double k_p, double k_d, const ConstRef& theta_r,
                      const ConstRef& thetadot_r, const ConstRef& thetaddot_r, const ConstRef& forces, double dt,
-                     Ref x_next, Ref tau, Ref L) {
-  const double sigma = tracking_control(x, g_b, g_m, k_p, k_d, theta_r, thetadot_r, thetaddot_r, tau, L);
-  advance(x, tau, forces, dt, x_next);
+                     bool staged, Ref x_next, Ref tau, Ref L) {
+  const auto at = [&](const ConstRef& r, Index k) { return stage_sample(r, k, n_); };
+  const auto gain = [&](Index k) { return stage_sample(g_b, k, 1)(0); };
+  const double sigma =
+      tracking_control(x, gain(0), g_m, k_p, k_d, at(theta_r, 0), at(thetadot_r, 0), at(thetaddot_r, 0), tau, L);
+  const StageLaw law = [&](Index k, const ConstRef& x_s, Ref tau_s, Ref L_s) {
+    tracking_control(x_s, gain(k), g_m, k_p, k_d, at(theta_r, k), at(thetadot_r, k), at(thetaddot_r, k), tau_s, L_s);
+  };
+  advance(x, tau, forces, dt, x_next, staged ? &law : nullptr);
   return sigma;
 }
 
@@ -113,10 +129,41 @@ double ClosedLoop::velocity_control(const ConstRef& x, double g_b, double g_m, d
   return sigma;
 }
 
-double ClosedLoop::velocity_step(const ConstRef& x, double g_b, double g_m, double w_s, bool feedforward, const ConstRef& theta_r,
-                     const ConstRef& thetadot_r, const ConstRef& forces, double dt, Ref x_next, Ref tau, Ref L) {
-  const double sigma = velocity_control(x, g_b, g_m, w_s, feedforward, theta_r, thetadot_r, tau, L);
-  advance(x, tau, forces, dt, x_next);
+double ClosedLoop::velocity_step(const ConstRef& x, const ConstRef& g_b, double g_m, double w_s, bool feedforward, const ConstRef& theta_r,
+                     const ConstRef& thetadot_r, const ConstRef& forces, double dt, bool staged, Ref x_next, Ref tau,
+                     Ref L) {
+  const auto at = [&](const ConstRef& r, Index k) { return stage_sample(r, k, n_); };
+  const auto gain = [&](Index k) { return stage_sample(g_b, k, 1)(0); };
+  const double sigma = velocity_control(x, gain(0), g_m, w_s, feedforward, at(theta_r, 0), at(thetadot_r, 0), tau, L);
+  const StageLaw law = [&](Index k, const ConstRef& x_s, Ref tau_s, Ref L_s) {
+    velocity_control(x_s, gain(k), g_m, w_s, feedforward, at(theta_r, k), at(thetadot_r, k), tau_s, L_s);
+  };
+  advance(x, tau, forces, dt, x_next, staged ? &law : nullptr);
+  return sigma;
+}
+
+// The joint servo: theta'' = theta_r'' + k_d (theta_r' - theta') + k_p (theta_r - theta), realised.
+
+double ClosedLoop::servo_control(const ConstRef& x, double k_p, double k_d, const ConstRef& theta_r,
+                                 const ConstRef& thetadot_r, const ConstRef& thetaddot_r, Ref tau, Ref L) {
+  check_sizes(x, tau, L);
+  check_reference(theta_r, thetadot_r, thetaddot_r);
+  const ConstRef q = x.head(nv_);
+  const ConstRef v = x.tail(nv_);
+  const double sigma = coupling(q, v, L);
+  realize(q, v, thetaddot_r + k_d * (thetadot_r - v.tail(n_)) + k_p * (theta_r - q.tail(n_)), tau);
+  return sigma;
+}
+
+double ClosedLoop::servo_step(const ConstRef& x, double k_p, double k_d, const ConstRef& theta_r,
+                              const ConstRef& thetadot_r, const ConstRef& thetaddot_r, const ConstRef& forces, double dt,
+                              bool staged, Ref x_next, Ref tau, Ref L) {
+  const auto at = [&](const ConstRef& r, Index k) { return stage_sample(r, k, n_); };
+  const double sigma = servo_control(x, k_p, k_d, at(theta_r, 0), at(thetadot_r, 0), at(thetaddot_r, 0), tau, L);
+  const StageLaw law = [&](Index k, const ConstRef& x_s, Ref tau_s, Ref L_s) {
+    servo_control(x_s, k_p, k_d, at(theta_r, k), at(thetadot_r, k), at(thetaddot_r, k), tau_s, L_s);
+  };
+  advance(x, tau, forces, dt, x_next, staged ? &law : nullptr);
   return sigma;
 }
 
@@ -129,14 +176,15 @@ void ClosedLoop::check_reference(const ConstRef& a, const ConstRef& b, const Con
   if (a.size() != n_ || b.size() != n_ || c.size() != n_) throw std::invalid_argument("references have n entries");
 }
 
-// One RK4 step with the torque held; forces = (f(t), f(t + dt/2), f(t + dt)), 3 m entries.
+// One RK4 step, the torque held or the law's at each stage; forces = (f(t), f(t + dt/2), f(t + dt)).
 
 // The result must be finite.
 
-void ClosedLoop::advance(const ConstRef& x, const Ref& tau, const ConstRef& forces, double dt, Ref x_next) {
+void ClosedLoop::advance(const ConstRef& x, const Ref& tau, const ConstRef& forces, double dt, Ref x_next,
+                         const StageLaw* law) {
   if (forces.size() != 3 * m_ || x_next.size() != 2 * nv_)
     throw std::invalid_argument("forces has 3 m entries (f at t, t + dt/2, t + dt), x_next 2 nv");
-  rk4(x, tau, forces, dt, x_next);
+  rk4(x, tau, forces, dt, x_next, law);
   if (!(x_next.allFinite() && tau.allFinite())) throw std::domain_error("the state became non-finite");
 }
 
@@ -174,15 +222,17 @@ double ClosedLoop::coupling(const ConstRef& q, const ConstRef& v, Ref L) {
   L = H_bm_ * thetadot;
   pinv_.resize(n_, r_);
   double sigma;
-  if (r_ == 1) {
-    const double sigma2 = H_bm_.row(0).squaredNorm();
+  if (r_ == 1) {  // the column h w^2 / (w^2 |h|^2 + lambda^2)
+    const double w2 = weights_(0) * weights_(0);
+    const double sigma2 = w2 * H_bm_.row(0).squaredNorm();
     sigma = std::sqrt(sigma2);
-    pinv_.col(0) = H_bm_.row(0).transpose() / (sigma2 + damping_squared(sigma, threshold_, max_damping_));
-  } else {
-    sigma = smallest_singular_value(H_bm_);
+    pinv_.col(0) = H_bm_.row(0).transpose() * (w2 / (sigma2 + damping_squared(sigma, threshold_, max_damping_)));
+  } else {  // (W H)^T (W H (W H)^T + lambda^2 E)^-1 W
+    const MatrixXd WH = weights_.asDiagonal() * H_bm_;
+    sigma = smallest_singular_value(WH);
     const double lam2 = damping_squared(sigma, threshold_, max_damping_);
-    const MatrixXd A = H_bm_ * H_bm_.transpose() + lam2 * MatrixXd::Identity(r_, r_);
-    pinv_ = H_bm_.transpose() * A.partialPivLu().solve(MatrixXd::Identity(r_, r_));
+    const MatrixXd A = WH * WH.transpose() + lam2 * MatrixXd::Identity(r_, r_);
+    pinv_ = WH.transpose() * A.partialPivLu().solve(MatrixXd::Identity(r_, r_)) * weights_.asDiagonal();
   }
   return sigma;
 }
@@ -228,21 +278,23 @@ const VectorXd& ClosedLoop::held_acceleration(const ConstRef& q, const ConstRef&
   return pinocchio::aba(model_, plant_data_, q, v, ConstRef(u_));
 }
 
-// Classical RK4 on x = (q, v) with the torque held and the force at the stage times: k_1 at t,
+// Classical RK4 on x = (q, v) with the force at the stage times: k_1 at t, k_2 and k_3 at t + dt/2,
 
-// k_2 and k_3 at t + dt/2, k_4 at t + dt (rns_viz.sim.Plant.rk4_state_step).
+// k_4 at t + dt, and the torque held or the law's at each stage (rns_viz.sim.Plant.rk4_state_step).
 
 void ClosedLoop::rk4(const ConstRef& x, const ConstRef& tau, const ConstRef& forces, double dt,
-         Eigen::Ref<VectorXd> x_next) {
+         Eigen::Ref<VectorXd> x_next, const StageLaw* law) {
   static constexpr double stage_step[3] = {0.5, 0.5, 1.0};
   static constexpr double weight[4] = {1.0, 2.0, 2.0, 1.0};
   static constexpr Index force_sample[4] = {0, 1, 1, 2};
   slope_sum_.setZero();
   stage_ = x;
   for (int s = 0; s < 4; ++s) {
+    if (law != nullptr && s > 0) (*law)(force_sample[s], stage_, stage_tau_, stage_L_);  // the law at this stage
     // slope k_s = (v_s, a_s) at the stage state
+    const ConstRef tau_s = (law != nullptr && s > 0) ? ConstRef(stage_tau_) : tau;
     const VectorXd& a =
-        held_acceleration(stage_.head(nv_), stage_.tail(nv_), tau, forces.segment(force_sample[s] * m_, m_));
+        held_acceleration(stage_.head(nv_), stage_.tail(nv_), tau_s, forces.segment(force_sample[s] * m_, m_));
     slope_sum_.head(nv_) += weight[s] * stage_.tail(nv_);
     slope_sum_.tail(nv_) += weight[s] * a;
     if (s < 3) {

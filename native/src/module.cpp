@@ -21,7 +21,7 @@ using rns_native::RobotModel;
 NB_MODULE(_core, mod) {
   mod.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
   // what rns_viz.sim.native expects of this module; raised when a call changes its arguments
-  mod.attr("API_VERSION") = 2;
+  mod.attr("API_VERSION") = 3;
   nb::register_exception_translator([](const std::exception_ptr& p, void*) {
     try {
       std::rethrow_exception(p);
@@ -37,8 +37,9 @@ NB_MODULE(_core, mod) {
       .def("com_jacobians", &RobotModel::com_jacobians)
       .def("centers_of_mass", &RobotModel::centers_of_mass);
   nb::class_<ClosedLoop>(mod, "ClosedLoop")
-      .def(nb::init<const RobotModel&, const std::vector<int>&, const MatrixXd&, const MatrixXd&, const MatrixXd&, double,
-                    double, bool, const std::string&, int, const std::vector<int>&>())
+      .def(nb::init<const RobotModel&, const std::vector<int>&, const rns_native::VectorXd&, const MatrixXd&,
+                    const MatrixXd&, const MatrixXd&, double, double, bool, const std::string&, int,
+                    const std::vector<int>&>())
       .def("damped_control", &ClosedLoop::damped_control)
       .def("damped_step", &ClosedLoop::damped_step)
       .def("tracking_control", &ClosedLoop::tracking_control)
@@ -46,5 +47,7 @@ NB_MODULE(_core, mod) {
       .def("task_control", &ClosedLoop::task_control)
       .def("task_step", &ClosedLoop::task_step)
       .def("velocity_control", &ClosedLoop::velocity_control)
-      .def("velocity_step", &ClosedLoop::velocity_step);
+      .def("velocity_step", &ClosedLoop::velocity_step)
+      .def("servo_control", &ClosedLoop::servo_control)
+      .def("servo_step", &ClosedLoop::servo_step);
 }

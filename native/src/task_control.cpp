@@ -56,11 +56,18 @@ std::pair<double, double> ClosedLoop::task_control(const ConstRef& x, double g_b
   return {sigma, sigma_jbar};
 }
 
-std::pair<double, double> ClosedLoop::task_step(const ConstRef& x, double g_b, double g_m, double G_p, double G_d, double threshold,
+std::pair<double, double> ClosedLoop::task_step(const ConstRef& x, const ConstRef& g_b, double g_m, double G_p, double G_d, double threshold,
                     const ConstRef& x_d, const ConstRef& xdot_d, const ConstRef& xddot_d, const ConstRef& forces,
-                    double dt, Ref x_next, Ref tau, Ref L) {
-  const auto sigmas = task_control(x, g_b, g_m, G_p, G_d, threshold, x_d, xdot_d, xddot_d, tau, L);
-  advance(x, tau, forces, dt, x_next);
+                    double dt, bool staged, Ref x_next, Ref tau, Ref L) {
+  const Index p = static_cast<Index>(task_rows_.size());
+  const auto at = [&](const ConstRef& r, Index k) { return stage_sample(r, k, p); };
+  const auto gain = [&](Index k) { return stage_sample(g_b, k, 1)(0); };
+  const auto sigmas =
+      task_control(x, gain(0), g_m, G_p, G_d, threshold, at(x_d, 0), at(xdot_d, 0), at(xddot_d, 0), tau, L);
+  const StageLaw law = [&](Index k, const ConstRef& x_s, Ref tau_s, Ref L_s) {
+    task_control(x_s, gain(k), g_m, G_p, G_d, threshold, at(x_d, k), at(xdot_d, k), at(xddot_d, k), tau_s, L_s);
+  };
+  advance(x, tau, forces, dt, x_next, staged ? &law : nullptr);
   return sigmas;
 }
 

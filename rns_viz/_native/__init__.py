@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from rns_viz.model import FsmsModel
 
-API_VERSION = 2  # the calls rns_viz.sim.native makes; rns_viz_native.API_VERSION must equal it
+API_VERSION = 3  # the calls rns_viz.sim.native makes; rns_viz_native.API_VERSION must equal it
 INSTALL_HINT = "pip install ./native from the rns_viz repository"
 MODEL_TOLERANCE = 1e-12  # relative: the C++ model must give pinocchio's Python numbers
 NOT_INSTALLED = f"rns_viz_native is not installed (optional: {INSTALL_HINT})"

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import operator
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Literal, NamedTuple, Protocol
 
 import numpy as np
@@ -17,7 +17,14 @@ from rns_viz.model import FsmsModel
 
 if TYPE_CHECKING:
     from rns_viz.control.reference import ReferenceSample
-from rns_viz.rns import DampedInverse, damped_pinv, damped_row_pinv, project_onto_rns, rns_projector
+from rns_viz.rns import (
+    DampedInverse,
+    damped_row_pinv,
+    project_onto_rns,
+    rns_projector,
+    singularity_distance,
+    weighted_damped_pinv,
+)
 
 LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
@@ -58,11 +65,11 @@ class ControlOutput:
 
     tau: np.ndarray  # (n,) N m
     coupling_momentum: np.ndarray  # (r,) L = S H_bm theta', Eq. (8)
-    sigma_hbm: float  # distance to singularity of S H_bm (its smallest singular value)
+    sigma_hbm: float  # distance to singularity of S H_bm, kg m: sigma_min(W S H_bm) (rns.singularity_distance)
     sigma_jbar: float = math.nan  # distance to singularity of J-bar (tracking laws)
     theta_ref: np.ndarray | None = None  # (n,) rad
     ee_ref: np.ndarray | None = None  # (p,) m, base frame
-    extra: dict[str, float] = field(default_factory=dict)
+    extra: dict[str, float] | None = None  # a law's own extra outputs (None: none)
 
 
 class ControlLaw(Protocol):
@@ -77,6 +84,16 @@ class ControlLaw(Protocol):
     def suppress(self) -> bool: ...
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> ControlOutput: ...
+
+    def sampled(self, t: float) -> bool:
+        """How the simulator applies this law over the step that starts at t.
+
+        True: a digital controller, its torque computed at t and held over the step (vibration
+        suppression, g_b in force). False: a joint servo on the measured state, evaluated wherever
+        the integrator evaluates the plant (every RK4 stage, its state and time): a held arm then stays
+        held and the base rings as the structure alone, not fed back by a torque half a step late.
+        """
+        ...
 
     def retune(self, gains: Gains) -> None:
         """New gains (and the null-space input's), from the next step on."""
@@ -150,7 +167,7 @@ class Coupling:
         self.coupling_momentum = H_bm.dot(self.thetadot)  # (r,) L = S H_bm theta', Eq. (8)
         self.row: CouplingRow | None = None  # the same coupling in Python floats (r = 1, CouplingEvaluator)
         self.inverse = inverse  # the damped H_bm^+ (rns.damped_pinv)
-        self.sigma = inverse.sigma_min  # smallest singular value of S H_bm
+        self.sigma = inverse.sigma_min  # sigma_min(W S H_bm), kg m: the distance to singularity
         self._m, self._rows, self._H_b_index = m, rows, H_b_index
         self._q, self._v, self._hbm_dot = q, v, hbm_dot_thetadot  # (m+n,), (m+n,), (m,)
         self._P: np.ndarray | None = None
@@ -226,24 +243,26 @@ class CouplingEvaluator:
         all_rows = len(self.rows) == m
         self._rows: slice | np.ndarray = slice(0, m) if all_rows else self.rows
         self._H_b_index = (slice(0, m), slice(0, m)) if all_rows else np.ix_(self.rows, self.rows)
-        # Damping starts below 10 % of sigma_min(S H_bm) at the default configuration (kg m or kg m^2;
-        # |h| for one row) and reaches that same value at rank loss, so |H_bm^+| <= 10 / sigma_min(theta_0)
-        # (sigma / (sigma^2 + lambda^2) peaks just below that). sigma_min, not the norm: a 6-row coupling
-        # mixes kg m and kg m^2 rows, its sigma_min far below its norm (boom7: 0.034 vs 6).
+        # Damping starts below 10 % of the distance to singularity sigma_min(W S H_bm) at the default
+        # configuration (kg m: moment rows divided by the arm's length, rns.singularity_distance; |h| for
+        # one row) and reaches that same value at rank loss, so |W H_bm^+| <= 10 / sigma_min(theta_0)
+        # (sigma / (sigma^2 + lambda^2) peaks just below that). The damping acts on W S H_bm too, so its
+        # onset and size are in one unit for every row (boom7: sigma_min 0.033 kg m, |W S H_bm| 3.1).
+        self.weights = model.coupling_weights
         q0 = model.q(model.spec.default_configuration)
-        scale = float(np.linalg.svd(model.coupling_matrix(q0), compute_uv=False)[-1])
+        scale = float(singularity_distance(model.coupling_matrix(q0), self.weights))
         self.threshold = singular_threshold if singular_threshold is not None else 0.1 * max(scale, 1e-9)
         self.max_damping = self.threshold
         # A 1-DOF base's one row in Python floats. Not one selected row of a larger base: S acts on the
         # rows of H_b, so S H_b x_b' needs every base velocity, not the selected diagonal entry.
-        self._row = 0 if m == 1 else None
+        self._row = 0 if m == 1 and self.weights is None else None
 
     def __call__(self, q: np.ndarray, v: np.ndarray) -> Coupling:
         M, c, hbm_dot = self.model.dynamics(q, v)
         if self._row is not None:
             return self._one_row(M, c, hbm_dot, q, v, self._row)
         H_bm = M[self._rows, self.model.m :]
-        inverse = damped_pinv(H_bm, self.threshold, self.max_damping)
+        inverse = weighted_damped_pinv(H_bm, self.weights, self.threshold, self.max_damping)
         return Coupling(M, c, hbm_dot, H_bm, inverse, q, v, self._rows, self._H_b_index)
 
     def _one_row(

@@ -32,11 +32,11 @@ from rns_viz.control.null_input import TaskReference
 from rns_viz.control.reference import ReferenceSample, TaskSample
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import quintic
-from rns_viz.rns import damped_pinv
+from rns_viz.rns import damped_pinv, singularity_distance, weighted_damped_pinv
 
 LIMIT_MARGIN = math.radians(30.0)  # rad: the limit term of the avoidance measure acts this close to a limit
-AVOID_EVERY = 10  # calls between evaluations of the avoidance gradient (a slow null-space drift; its
-# RNEA derivatives cost as much as the rest of the law); P_2 is applied to it at every call
+AVOID_EVERY_S = 0.01  # s between evaluations of the avoidance gradient (ten 1 ms steps; a slow null-space
+# drift, its RNEA derivatives cost as much as the rest of the law); P_2 is applied to it at every call
 
 
 @dataclass(frozen=True)
@@ -100,8 +100,9 @@ class CompensatingLaw:
         self.coupling = CouplingEvaluator(model)
         theta0 = model.spec.default_configuration
         self.hold = np.array(theta0[self.comp] if hold is None else hold, dtype=float)
-        # Damping of H_bm,2^+ starts below 10 % of sigma_min(S H_bm,2) at theta_0 (as CouplingEvaluator).
-        sigma0 = float(np.linalg.svd(self._comp_coupling(model.q(theta0)), compute_uv=False)[-1])
+        # Damping of H_bm,2^+ starts below 10 % of sigma_min(W S H_bm,2) at theta_0 (as CouplingEvaluator).
+        self.weights = model.coupling_weights
+        sigma0 = float(singularity_distance(self._comp_coupling(model.q(theta0)), self.weights))
         self.threshold = 0.1 * max(sigma0, 1e-9)
         m = model.m
         self._lower, self._upper = model.lower[self.comp], model.upper[self.comp]
@@ -112,12 +113,17 @@ class CompensatingLaw:
         self._cols = m + self.comp  # compensator columns of M
         self._t = 0.0
         self._rehold = False
-        self._grad: np.ndarray | None = None  # the avoidance gradient in use, and calls since it was taken
-        self._grad_age = 0
+        self._grad: np.ndarray | None = None  # the avoidance gradient in use, and when it was taken (s)
+        self._grad_t = math.nan
 
     # -- ControlLaw protocol ------------------------------------------------------------------
     def retune(self, gains: Gains) -> None:
         self.gains = gains
+
+    def sampled(self, t: float) -> bool:
+        """A digital controller while it suppresses through the compensator (g_b in force); held or only
+        cancelling the reaction, a joint servo (see ControlLaw.sampled)."""
+        return self.compensate and self.suppress and self.gains.g_b != 0.0
 
     def set_suppression(self, on: bool) -> None:
         """Switch the G_b term (vibration suppression through the compensator) on or off."""
@@ -154,7 +160,7 @@ class CompensatingLaw:
         return acc, inv.sigma_min, x_d
 
     def avoidance_gradient(self, q: np.ndarray, H2: np.ndarray) -> np.ndarray:
-        """grad over theta_2 of w = ln det(H2 H2^T + eps^2 E) - sum (1 - d/delta)_+^2, 1/rad.
+        """grad over theta_2 of w = ln det(A A^T + eps^2 E) - sum (1 - d/delta)_+^2, 1/rad, A = W H2 (rows in kg m).
 
         d: distance of a joint to each of its limits; delta = LIMIT_MARGIN, so the limits act only near them.
 
@@ -164,10 +170,13 @@ class CompensatingLaw:
         """
         rows = self.model.selected
         r = H2.shape[0]
+        weights = np.ones(r) if self.weights is None else self.weights
+        H2 = H2 * weights[:, None]
         if r == 1:  # one base row: W = h / (|h|^2 + eps^2) without a solve
             W = H2 / (float(H2[0].dot(H2[0])) + self.threshold**2)
         else:
             W = np.linalg.solve(H2 @ H2.T + self.threshold**2 * np.eye(r), H2)
+        W = W * weights[:, None]  # d(W H2)_ij = w_i dH2_ij: the weights once more on the rows of M's derivative
         grad = np.zeros(len(self.comp))
         a = self._zeros.copy()
         for i in range(r):
@@ -186,14 +195,13 @@ class CompensatingLaw:
         cp = self.coupling(q, v)
         acc1, sigma_j, x_d = self.task_acceleration(q, v)
         H1, H2 = cp.H_bm[:, self.task], cp.H_bm[:, self.comp]
-        inv2 = damped_pinv(H2, self.threshold, self.threshold)
+        inv2 = weighted_damped_pinv(H2, self.weights, self.threshold, self.threshold)
         thetadot2 = v[self._cols]
         if self.compensate:
             g_b = g.g_b if self.suppress else 0.0
             y = g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g.g_m * cp.coupling_momentum - H1 @ acc1
-            if self._grad is None or self._grad_age >= AVOID_EVERY:
-                self._grad, self._grad_age = self.avoidance_gradient(q, H2), 0
-            self._grad_age += 1
+            if self._grad is None or not 0.0 <= t - self._grad_t < AVOID_EVERY_S - 1e-9:  # 1e-9 s: summed steps
+                self._grad, self._grad_t = self.avoidance_gradient(q, H2), t
             u2 = self.avoid_gain * self._grad - self.null_damping * thetadot2
             acc2 = inv2.inverse @ y + u2 - inv2.inverse @ (H2 @ u2)  # H_bm,2^+ y + P_2 u_2, Eqs. (9), (15)
         else:

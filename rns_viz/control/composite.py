@@ -38,6 +38,10 @@ class CompositeLaw:
         """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
         return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
 
+    def sampled(self, t: float) -> bool:
+        """A digital controller while g_b is in force; without it a joint servo (see ControlLaw.sampled)."""
+        return self.suppression_gain(t) != 0.0
+
     def retune(self, gains: Gains) -> None:
         """New gains for the law and its null-space input, from the next step on."""
         self.gains = gains

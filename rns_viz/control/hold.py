@@ -12,7 +12,9 @@ from rns_viz.model import FsmsModel
 class JointServo:
     """Stiff joint-space servo: theta'' = theta_r'' + k_d (theta_r' - theta') + k_p (theta_r - theta).
 
-    With a fixed reference this is "joints held": the arm does nothing about the base.
+    With a fixed reference this is "joints held": the arm does nothing about the base. It is never
+    sampled (:meth:`sampled`): evaluated at every RK4 stage, the computed torque keeps theta'' at the
+    servo's value whatever the base does, so a held arm is rigid and the base rings as the structure.
     """
 
     kind = "servo"
@@ -29,6 +31,10 @@ class JointServo:
 
     def set_suppression(self, on: bool) -> None:
         """No g_b term to switch: the servo stays a comparison without suppression."""
+
+    def sampled(self, t: float) -> bool:
+        """Never: a joint servo acts on the measured state at every stage (see the protocol)."""
+        return False
 
     def follow(self, sample: ReferenceSample) -> None:
         if not isinstance(sample, JointSample):
@@ -73,6 +79,9 @@ class Switched:
 
     def set_suppression(self, on: bool) -> None:
         self.after.set_suppression(on)
+
+    def sampled(self, t: float) -> bool:
+        return (self.after if t >= self.at else self.before).sampled(t)
 
     def follow(self, sample: ReferenceSample) -> None:
         self.before.follow(sample)

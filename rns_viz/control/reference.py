@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -36,19 +36,27 @@ JointQuintic = QuinticSegment  # point-to-point joint motion (Fig. 11(b))
 @dataclass(frozen=True)
 class JointSample:
     """theta_ref, theta_ref', theta_ref'' at one instant (rad, rad/s, rad/s^2): what a live loop hands a
-    law with :meth:`follow` at each step. Immutable, so no one changes it behind the law's back."""
+    law with :meth:`follow` at each step. Immutable, so no one changes it behind the law's back.
+
+    ``t0``: when it was taken (s; :meth:`taken_at`). A law evaluated at other times within the step
+    (a joint servo at the RK4 stages, ControlLaw.sampled) then sees the sample's Taylor polynomial,
+    theta + tau theta' + tau^2/2 theta'' with tau = t - t0; None: the same values at every time."""
 
     theta: np.ndarray
     thetadot: np.ndarray
     thetaddot: np.ndarray
+    t0: float | None = None
 
     @classmethod
     def held(cls, theta: np.ndarray) -> JointSample:
         theta = np.array(theta, dtype=float)
         return cls(theta, np.zeros_like(theta), np.zeros_like(theta))
 
+    def taken_at(self, t: float) -> JointSample:
+        return replace(self, t0=t)
+
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return self.theta, self.thetadot, self.thetaddot
+        return _near(self.theta, self.thetadot, self.thetaddot, self.t0, t)
 
 
 @dataclass(frozen=True)
@@ -58,17 +66,31 @@ class TaskSample:
     x: np.ndarray
     xdot: np.ndarray
     xddot: np.ndarray
+    t0: float | None = None
 
     @classmethod
     def held(cls, x: np.ndarray) -> TaskSample:
         x = np.array(x, dtype=float)
         return cls(x, np.zeros_like(x), np.zeros_like(x))
 
+    def taken_at(self, t: float) -> TaskSample:
+        return replace(self, t0=t)
+
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return self.x, self.xdot, self.xddot
+        return _near(self.x, self.xdot, self.xddot, self.t0, t)
 
 
 ReferenceSample = JointSample | TaskSample
+
+
+def _near(
+    value: np.ndarray, rate: np.ndarray, acceleration: np.ndarray, t0: float | None, t: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sample taken at t0, at time t: itself at t0 (or without t0), its Taylor polynomial elsewhere."""
+    if t0 is None or t == t0:
+        return value, rate, acceleration
+    tau = t - t0
+    return value + tau * rate + 0.5 * tau * tau * acceleration, rate + tau * acceleration, acceleration
 
 
 class PathReference:

@@ -47,6 +47,11 @@ class VelocityLaw:
         """g_b in force at time t, 1/s (0 before ``suppress_after`` or without suppression)."""
         return self.gains.g_b if self.suppress and t >= self.suppress_after else 0.0
 
+    def sampled(self, t: float) -> bool:
+        """A digital controller while g_b is in force; without it the servo holds or tracks theta_ref
+        (see ControlLaw.sampled)."""
+        return self.suppression_gain(t) != 0.0
+
     def retune(self, gains: Gains) -> None:
         self.gains = gains
 

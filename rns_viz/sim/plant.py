@@ -6,6 +6,8 @@ x = (q, v) for the RK4 step, which runs at every control step and reuses its sta
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pinocchio as pin
 
@@ -13,6 +15,8 @@ from rns_viz.model import FsmsModel
 from rns_viz.sim.disturbance import StageForces
 
 RK4_WEIGHTS = np.array([1.0, 2.0, 2.0, 1.0]) / 6.0  # b_i of the classical RK4
+# (h, q_s, v_s) -> the torque at an RK4 stage: its time t + h (h = dt/2, dt/2, dt) and state
+StageTorque = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
 
 class Plant:
@@ -41,7 +45,7 @@ class Plant:
         self._stage_x = [row[: 2 * nv] for row in self._stages]
         self._stage_k = [row[nv:] for row in self._stages]
         self._slopes = self._stages[:, nv:]  # (4, 2 nv): k_1 .. k_4
-        self._weights_dt = (0.0, RK4_WEIGHTS * 0.0)  # (dt, b_i dt), cached
+        self._weights_dt = (0.0, RK4_WEIGHTS * 0.0, (0.0, 0.0, 0.0, None))  # (dt, b_i dt, stage steps), cached
 
     def hold(self, tau: np.ndarray, f_ext: np.ndarray | None) -> None:
         """Set the joint torques and base force used by :meth:`held_acceleration`."""
@@ -81,18 +85,29 @@ class Plant:
         return x[:nv], x[nv:]
 
     def rk4_state_step(
-        self, x: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | StageForces | None, dt: float
+        self,
+        x: np.ndarray,
+        tau: np.ndarray,
+        f_ext: np.ndarray | StageForces | None,
+        dt: float,
+        torque_at: StageTorque | None = None,
     ) -> np.ndarray:
         """:meth:`rk4_step` on the stacked state x = (q, v); returns a new array.
 
         Stages x_{s+1} = x + c_s k_s (c = dt/2, dt/2, dt) with slopes k_s = (v_s, a_s); the step is
         x + dt (k_1 + 2 k_2 + 2 k_3 + k_4) / 6. ``f_ext``: one base force held over the step, or
         its samples at the stage times (f(t), f(t + dt/2), f(t + dt)) for k_1, k_2 and k_3, k_4.
+        ``torque_at``: None holds ``tau`` over the step; else ``tau`` is the first stage's torque
+        and ``torque_at(h, q_s, v_s)`` gives the others' at their times t + h and states (a law
+        evaluated wherever the plant is: a joint servo, or continuous-time control).
         """
         sampled = isinstance(f_ext, tuple)
         self.hold(tau, f_ext[0] if sampled else f_ext)  # type: ignore[index, arg-type]
         if self._scalar_base:
-            return self._rk4_scalar_base(x, f_ext if sampled else None, dt)  # type: ignore[arg-type]
+            samples = f_ext if sampled else None
+            if torque_at is not None:  # a servo at every stage: the general stages, the torque set per stage
+                return self._rk4_staged_scalar_base(x, samples, dt, torque_at)  # type: ignore[arg-type]
+            return self._rk4_scalar_base(x, samples, dt)  # type: ignore[arg-type]
         q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
         xs[0][:] = x
         for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
@@ -100,8 +115,14 @@ class Plant:
             np.add(x, c * k[s], out=xs[s + 1])
             if sampled and s != 1:  # k_2 and k_3 at t + dt/2, k_4 at t + dt
                 self._set_force(f_ext[s // 2 + 1])  # type: ignore[index]
+            if torque_at is not None:
+                self._set_torque(torque_at(c, q[s + 1], v[s + 1]))
         a[3][:] = self.held_acceleration(q[3], v[3])
-        return x + self._weights(dt).dot(self._slopes)
+        return x + self._weights(dt)[0].dot(self._slopes)
+
+    def _set_torque(self, tau: np.ndarray) -> None:
+        self._tau = tau
+        self._u[self._m :] = tau
 
     def _rk4_scalar_base(self, x: np.ndarray, samples: StageForces | None, dt: float) -> np.ndarray:
         """:meth:`rk4_state_step` for a 1-DOF base, inputs set by :meth:`hold`: the same stages, with
@@ -117,7 +138,8 @@ class Plant:
             f_mid, f_end = (0.0 if g is None else float(g[0]) for g in samples[1:])
             forces = (f, f_mid, f_mid, f_end)
         xs[0][:] = x
-        for s, c in enumerate((0.5 * dt, 0.5 * dt, dt, None)):
+        weights, steps = self._weights(dt)
+        for s, c in enumerate(steps):
             q_s, v_s = q[s], v[s]
             u[0] = -k_b * q_s.item(0) - d_b * v_s.item(0) + forces[s]
             if damped:
@@ -125,12 +147,30 @@ class Plant:
             a[s][:] = aba(pin_model, data, q_s, v_s, u)
             if c is not None:
                 add(x, c * k[s], xs[s + 1])
-        return x + self._weights(dt).dot(self._slopes)
+        return x + weights.dot(self._slopes)
 
-    def _weights(self, dt: float) -> np.ndarray:
+    def _rk4_staged_scalar_base(
+        self, x: np.ndarray, samples: StageForces | None, dt: float, torque_at: StageTorque
+    ) -> np.ndarray:
+        """:meth:`_rk4_scalar_base` with the torque of stages 2-4 from ``torque_at`` (held_acceleration
+        per stage: a servo's four law evaluations cost far more than the inlined base force saves)."""
+        q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
+        forces = (self._f, self._f, self._f) if samples is None else samples
+        xs[0][:] = x
+        for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
+            a[s][:] = self.held_acceleration(q[s], v[s])
+            np.add(x, c * k[s], out=xs[s + 1])
+            if s != 1:  # k_2 and k_3 at t + dt/2, k_4 at t + dt
+                self._set_force(forces[s // 2 + 1])
+            self._set_torque(torque_at(c, q[s + 1], v[s + 1]))
+        a[3][:] = self.held_acceleration(q[3], v[3])
+        return x + self._weights(dt)[0].dot(self._slopes)
+
+    def _weights(self, dt: float) -> tuple[np.ndarray, tuple[float, float, float, None]]:
+        """b_i dt and the stage steps (dt/2, dt/2, dt, None: after the last stage), cached for dt."""
         if self._weights_dt[0] != dt:
-            self._weights_dt = (dt, RK4_WEIGHTS * dt)
-        return self._weights_dt[1]
+            self._weights_dt = (dt, RK4_WEIGHTS * dt, (0.5 * dt, 0.5 * dt, dt, None))
+        return self._weights_dt[1], self._weights_dt[2]
 
     def semi_implicit_euler_step(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None, dt: float

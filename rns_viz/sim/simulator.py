@@ -1,10 +1,13 @@
 """The simulation loop: a control law driving the plant, with force events and a step log.
 
-Default: RK4 at 1 ms with the torque computed once per step and held over it (a digital
-controller), and the external force, a continuous input, sampled at the RK4 stage times t,
-t + dt/2 and t + dt. ``hold_control=False`` evaluates the law at every RK4 stage (continuous
-time), used where a closed-form continuous closed loop is the oracle. The log's ``fext`` columns
-hold the force at the row's time t (the first of the three samples).
+Default: RK4 at 1 ms with the external force, a continuous input, sampled at the RK4 stage times
+t, t + dt/2 and t + dt. A law that is sampled at t (``law.sampled(t)``: vibration suppression in
+force) is a digital controller: its torque is computed once per step and held over it. One that is
+not (a joint servo holding or moving the arm, a law with g_b = 0) is evaluated at every RK4 stage,
+its state and time, as a continuous-time loop: a held arm is held, and the base rings as the
+structure alone instead of being fed back half a step late. ``hold_control=False`` treats every
+law so (continuous time), where a closed-form continuous closed loop is the oracle. The log's
+``tau`` and ``fext`` columns hold the torque and force at the row's time t (the first stage).
 
 For laws (15) and (30) the whole step (law + RK4) runs in C++ when the optional native module is
 installed (:mod:`rns_viz.sim.native`); ``native=False`` forces Python.
@@ -60,7 +63,7 @@ class Simulator:
         self.force = force or NoForce()
         self.integrator = integrator
         self.hold_control = hold_control
-        self.use_native = native and native_step.available() and integrator == "rk4" and hold_control
+        self.use_native = native and native_step.available() and integrator == "rk4"
         self.law = law
         self.log_ee = log_ee  # end-effector columns; filled when the log is read (see _complete_rows)
         self._nv = model.nv
@@ -76,6 +79,8 @@ class Simulator:
     @law.setter
     def law(self, law: ControlLaw) -> None:
         self._law = law
+        # a bare callable (no ``sampled``) is a digital controller: its torque is held over each step
+        self._sampled = getattr(law, "sampled", _always_sampled)
         self._native = native_step.step_for(self.model, law) if self.use_native else None
 
     @property
@@ -124,44 +129,34 @@ class Simulator:
     def step(self) -> ControlOutput:
         """Compute the control at t, advance the state by dt, log the step; returns the control."""
         t, x, dt = self.t, self._x, self.dt
-        forces = stage_forces(self.force, t, dt)  # at t, t + dt/2, t + dt
+        force = self.force
+        forces = None if type(force) is NoForce else stage_forces(force, t, dt)  # at t, t + dt/2, t + dt
         f = None if forces is None else forces[0]
+        staged = not (self.hold_control and self._sampled(t))  # the law at every RK4 stage
         try:  # law and RK4 in one C++ call, which checks finiteness (None: the law is Python's)
-            stepped = self._native(t, x, forces, dt) if self._native is not None else None
+            stepped = self._native(t, x, forces, dt, staged) if self._native is not None else None
         except FloatingPointError:
             raise SimulationDiverged(_DIVERGED.format(t=t)) from None
         if stepped is not None:
             x_next, out = stepped
         else:
             q, v = x[: self._nv], x[self._nv :]
-            out = self._law(t, q, v)
-            if not self.hold_control:
-                x_next = np.concatenate(self._rk4_continuous(t, q, v, dt))
-            elif self.integrator == "rk4":
-                x_next = self.plant.rk4_state_step(x, out.tau, forces, dt)
+            law = self._law
+            out = law(t, q, v)
+            if self.integrator == "rk4":
+                at_stage = (lambda h, q_s, v_s: law(t + h, q_s, v_s).tau) if staged else None
+                x_next = self.plant.rk4_state_step(x, out.tau, forces, dt, at_stage)
             else:
                 x_next = np.concatenate(self.plant.semi_implicit_euler_step(q, v, out.tau, f, dt))
-            if not _all_finite(x_next, out.tau):
+            # no inf or NaN in x or tau: their sum of squares is finite (one number to test; entries
+            # beyond 1e154, where it overflows, mean a diverged run too)
+            tau = out.tau
+            if not math.isfinite(x_next.dot(x_next) + tau.dot(tau)):
                 raise SimulationDiverged(_DIVERGED.format(t=t))
         self._layout.write(self.log.next_row(), t, x, out, f)
         self._x, self.t = x_next, t + dt
         self.last, self.last_force = out, f
         return out
-
-    def _rk4_continuous(self, t: float, q: np.ndarray, v: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        def acc(ts: float, qs: np.ndarray, vs: np.ndarray) -> np.ndarray:
-            return self.plant.acceleration(qs, vs, self.law(ts, qs, vs).tau, self.force(ts))
-
-        h = 0.5 * dt
-        a1 = acc(t, q, v)
-        v2 = v + h * a1
-        a2 = acc(t + h, q + h * v, v2)
-        v3 = v + h * a2
-        a3 = acc(t + h, q + h * v2, v3)
-        v4 = v + dt * a3
-        a4 = acc(t + dt, q + dt * v3, v4)
-        s = dt / 6.0
-        return q + s * (v + 2.0 * (v2 + v3) + v4), v + s * (a1 + 2.0 * (a2 + a3) + a4)
 
     def _complete_rows(self, rows: np.ndarray) -> None:
         """The end-effector columns of newly logged rows, from their joint angles (run on reading)."""
@@ -185,7 +180,5 @@ class Simulator:
         return self.log
 
 
-def _all_finite(x: np.ndarray, tau: np.ndarray) -> bool:
-    """No inf or NaN in x or tau: their sum of squares is finite (one number to test; entries beyond
-    1e154, where it overflows, mean a diverged run too)."""
-    return math.isfinite(x.dot(x) + tau.dot(tau))
+def _always_sampled(t: float) -> bool:
+    return True

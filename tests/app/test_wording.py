@@ -26,9 +26,10 @@ from rns_viz.viz.server.app import RnsApp, start_app
 ROOT = Path(rns_viz.__file__).resolve().parent
 ITALIC = re.compile(r"(?<![*\w])\*(?!\*)([^*\n]+?)\*(?![*\w])")  # *name*, not **bold**
 # Any notation of a singular value of H_bm, and the one the app uses (with words first where it is named:
-# "distance to singularity"); sigma_min(...) in ASCII where a docstring names it.
-SIGMA_OF_HBM = re.compile(r"(σ|sigma)\S{0,20}?\(\s*(S\s*)?H(_|<sub>)?bm")
-NOTATIONS = ("σ_min(S H_bm", "σ<sub>min</sub>(S H<sub>bm", "sigma_min(S H_bm")
+# "distance to singularity"): the rows weighted into one unit by W (rns.singularity_distance);
+# sigma_min(...) in ASCII where a docstring names it.
+SIGMA_OF_HBM = re.compile(r"(σ|sigma)\S{0,20}?\(\s*(W\s*)?(S\s*)?H(_|<sub>)?bm")
+NOTATIONS = ("σ_min(W S H_bm", "σ<sub>min</sub>(W S H<sub>bm", "sigma_min(W S H_bm")
 
 
 @pytest.fixture(scope="module")
@@ -121,11 +122,11 @@ def test_the_distance_to_singularity_has_one_notation() -> None:
     found = [(where, text[m.start() : m.end()]) for where, text in shown_strings() for m in SIGMA_OF_HBM.finditer(text)]
     assert len(found) >= 5
     other = [(where, s) for where, s in found if not s.startswith(NOTATIONS)]
-    assert not other, f"other notations of sigma_min(S H_bm): {other}"
+    assert not other, f"other notations of sigma_min(W S H_bm): {other}"
 
 
 def test_the_readout_names_it_in_words_first(app: RnsApp) -> None:
     from rns_viz.viz.panels.panel_text import readouts_html
 
     html = readouts_html(app.session.snapshot())
-    assert "distance to singularity σ<sub>min</sub>(S H<sub>bm</sub>)" in html
+    assert "distance to singularity σ<sub>min</sub>(W S H<sub>bm</sub>)" in html

@@ -39,10 +39,9 @@ def drag_and_sample(session: Session, target: tuple[float, float], seconds: floa
 
 def test_drag_compensated_base_stays_still_and_task_is_the_shadows() -> None:
     """Drag across the workspace: peak |x_b| <= 1 % of the shadow's (compensator held), the task arm's
-    end effector (so its error against the common reference) equal in both runs to 1e-6 m.
-
-    The second drag starts with the shadow's beam ringing (D_b = 0): its mm swing then reaches the task
-    arm through the 1 ms torque hold at about 1e-6 m, so the equality is checked on the first drag.
+    end effector (so its error against the common reference) equal in both runs to 1e-6 m, also in the
+    second drag, which starts with the shadow's beam ringing at mm amplitude (D_b = 0): the held
+    compensator is a servo evaluated at every RK4 stage, so the swing does not reach the task arm.
     """
     session = Session("trep2", realtime=False)
     session.advance(0.1)
@@ -51,7 +50,8 @@ def test_drag_compensated_base_stays_still_and_task_is_the_shadows() -> None:
     for run in (first, second):
         assert np.abs(run["xb_shadow"]).max() > 1e-3  # the held compensator lets the task arm shake the beam (mm)
         assert np.abs(run["xb"]).max() <= 0.01 * np.abs(run["xb_shadow"]).max()
-    assert np.linalg.norm(first["ee"] - first["ee_shadow"], axis=1).max() <= 1e-6
+    for run in (first, second):
+        assert np.linalg.norm(run["ee"] - run["ee_shadow"], axis=1).max() <= 1e-6  # m
     assert np.linalg.norm(second["ee"][-1] - (-0.08, 0.10)) < 1e-4  # arrived (no reactionless restriction)
     snap = session.snapshot()
     assert snap.readouts.dual and snap.readouts.cancel is None

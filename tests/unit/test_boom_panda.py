@@ -102,9 +102,10 @@ def test_composition_hangs_the_packaged_arm_on_the_mount(
         x_b = rng.uniform(-1e-3, 1e-3, 6)
         M = pin.crba(model, data, np.concatenate([x_b, theta]))
         np.testing.assert_allclose(M[6:, 6:], oracle, rtol=1e-12, atol=1e-14)
-    # the base's translation block at rest: boom7's tip mass plus the whole stand-in arm (3.25 kg)
+    # the base's translation block at rest: boom7's tip (plate and condensed tube) plus the whole stand-in arm (3.25 kg)
     M = pin.crba(model, data, np.zeros(model.nq))
-    np.testing.assert_allclose(np.diag(M[:3, :3]), link_mass(ASSETS_DIR / "boom7.urdf", "boom_tip") + 3.25, rtol=1e-12)
+    tip = sum(link_mass(ASSETS_DIR / "boom7.urdf", link) for link in ("boom_tip", "boom_tube"))
+    np.testing.assert_allclose(np.diag(M[:3, :3]), tip + 3.25, rtol=1e-12)
 
 
 def test_a_parameter_file_extends_boom7_with_a_packaged_arm(

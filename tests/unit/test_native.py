@@ -7,7 +7,10 @@ mid-run agree to 1e-12, and so do the paper's presets run both ways; the laws al
 states, at the TREP singularity, for a 2-DOF base with one or both rows selected (the SVD branch)
 and with gravity (the Coriolis branch of H_bm' theta'). Eq. (24) tracking is compared on the 3R (a
 2-D RNS) and on the 2-DOF base; the path tracer's centre-of-mass kernels against pinocchio's Python
-calls. Skipped when the module is not installed, unless RNS_VIZ_REQUIRE_NATIVE=1 (CI's native job):
+calls. Steps that evaluate the law at every RK4 stage (a joint servo, a law without g_b, continuous-time
+control; g_b and the reference at the stage times) agree with Python's on the 3R and boom7, and the
+damped inverse of boom7's weighted moment rows where it damps. Skipped when the module is not
+installed, unless RNS_VIZ_REQUIRE_NATIVE=1 (CI's native job):
 then a missing or unusable module fails.
 """
 
@@ -28,6 +31,7 @@ from rns_viz.control import (
     FixedReference,
     Gains,
     JointQuintic,
+    JointServo,
     TorqueLaw,
     TrackEndEffector,
     TrackJointReference,
@@ -80,7 +84,7 @@ def test_trajectories_agree(name: str) -> None:
 
 
 def law_agrees(
-    model: FsmsModel, law: AccelerationLaw | VelocityLaw, q: np.ndarray, v: np.ndarray, t: float = 1.0
+    model: FsmsModel, law: AccelerationLaw | VelocityLaw | JointServo, q: np.ndarray, v: np.ndarray, t: float = 1.0
 ) -> None:
     step = native.NativeStep(model, law)
     got = step.control(t, np.concatenate((q, v)))
@@ -98,7 +102,7 @@ def law_agrees(
         assert (getattr(got, name) is None) if expected is None else np.array_equal(getattr(got, name), expected)
 
 
-def random_laws(model: FsmsModel) -> list[AccelerationLaw | VelocityLaw]:
+def random_laws(model: FsmsModel) -> list[AccelerationLaw | VelocityLaw | JointServo]:
     """One law of each natively computed kind, random gains, random quintic joint and task references."""
     gains = Gains(
         g_b=RNG.uniform(0, 50),
@@ -112,7 +116,8 @@ def random_laws(model: FsmsModel) -> list[AccelerationLaw | VelocityLaw]:
     damped = AccelerationLaw(model, gains, DampNullMotion(RNG.uniform(0, 30)))
     tracking = AccelerationLaw(model, gains, TrackJointReference(reference, gains.k_p, gains.k_d))
     velocity = VelocityLaw(model, gains, reference, feedforward=bool(RNG.integers(2)))
-    laws: list[AccelerationLaw | VelocityLaw] = [damped, tracking, velocity]
+    servo = JointServo(model, gains, reference)
+    laws: list[AccelerationLaw | VelocityLaw | JointServo] = [damped, tracking, velocity, servo]
     if model.n - len(model.selected) >= len(model.task_rows):  # an RNS wide enough for Eq. (24)
         ee0 = model.ee_position(theta0)[model.task_rows]
         target = JointQuintic(ee0, ee0 + RNG.uniform(-0.3, 0.3, len(ee0)), 2.0)
@@ -156,6 +161,21 @@ def test_law_agrees_at_random_states(name: str) -> None:
         q = np.r_[RNG.normal(0, 1e-2, model.m), RNG.uniform(-math.pi, math.pi, model.n)]
         v = RNG.normal(0, 1.0, model.nv)
         for law in random_laws(model):
+            law_agrees(model, law, q, v, t=RNG.uniform(0, 3))
+
+
+@pytest.mark.parametrize("selection", [(1, 1, 1, 1, 1, 1), (0, 0, 0, 0, 1, 1), (0, 0, 0, 0, 0, 1)])
+def test_law_agrees_with_weighted_moment_rows_where_it_damps(selection: tuple[int, ...]) -> None:
+    """boom7's moment rows weighted by 1/reach (rns.weighted_damped_pinv): six, two and one selected rows,
+    the damping threshold raised so that the damped inverse acts at every random state."""
+    model = FsmsModel.from_name("boom7").with_selection(selection)
+    assert model.coupling_weights is not None
+    for _ in range(10):
+        q = np.r_[RNG.normal(0, 1e-2, model.m), RNG.uniform(-math.pi, math.pi, model.n)]
+        v = RNG.normal(0, 1.0, model.nv)
+        for law in random_laws(model)[:3]:
+            law.coupling.threshold = law.coupling.max_damping = 50.0  # kg m: beyond sigma_min everywhere
+            assert law.coupling(q, v).inverse.damping > 0
             law_agrees(model, law, q, v, t=RNG.uniform(0, 3))
 
 
@@ -273,7 +293,49 @@ def test_other_laws_stay_in_python() -> None:
     assert not sims[0].native
     assert not Simulator(model, TorqueLaw(model, gains)).native
     assert not Simulator(model, AccelerationLaw(model, gains), integrator="semi-implicit-euler").native
-    assert not Simulator(model, AccelerationLaw(model, gains), hold_control=False).native
+
+
+def staged_laws(model: FsmsModel) -> dict[str, tuple[object, dict[str, object]]]:
+    """Each natively computed kind in a step that evaluates it at every RK4 stage (g_b and the reference
+    at the stage times): unsampled (a held or moving joint servo, g_b = 0) or under continuous-time control."""
+    gains = Gains(g_b=10.0, g_m=2.0, k_p=400.0, k_d=40.0)
+    theta0 = model.spec.default_configuration
+    quintic = JointQuintic(theta0, theta0 + 0.2, 0.6, t0=0.1)
+    ee0 = model.ee_position(theta0)[model.task_rows]
+    target = JointQuintic(ee0, ee0 + 0.02, 0.6, t0=0.1)
+    return {
+        "servo": (JointServo(model, gains, quintic), {}),
+        "damp": (AccelerationLaw(model, gains, suppress=False), {}),
+        "joint": (AccelerationLaw(model, gains, TrackJointReference(quintic, 400.0, 40.0), suppress=False), {}),
+        "task": (AccelerationLaw(model, gains, TrackEndEffector(model, target, 400.0, 40.0), suppress=False), {}),
+        "velocity": (VelocityLaw(model, gains, quintic, suppress=False, feedforward=True), {}),
+        "switching on": (AccelerationLaw(model, gains, suppress_after=0.3005), {}),  # g_b on at a stage time
+        "continuous": (VelocityLaw(model, gains, quintic), {"hold_control": False}),
+    }
+
+
+@pytest.mark.parametrize("name", ["planar3r", "boom7"])
+@pytest.mark.parametrize("kind", ["servo", "damp", "joint", "task", "velocity", "switching on", "continuous"])
+def test_steps_with_the_law_at_every_stage_agree(name: str, kind: str) -> None:
+    """A joint servo holding or moving the arm, laws without g_b and continuous-time control: the native
+    step evaluates the law at every stage as Python does, to 1e-12, through a kick."""
+    model = FsmsModel.from_name(name)
+    if name == "boom7" and kind == "task":
+        model = model.with_selection([1, 1, 1, 0, 0, 0])  # forces only: Eq. (24) in a 4-D RNS, as boom7-track
+    law, options = staged_laws(model)[kind]
+    kick = ForcePulse(0.05, 0.1, np.full(model.m, 2.0))
+    sims = pair(model, law, force=kick, q0=model.q(model.spec.default_configuration), **options)  # type: ignore[arg-type]
+    for s in sims:
+        s.run(0.6)
+    assert not options or not sims[0].hold_control
+    native_log, python_log = (s.log.array() for s in sims)
+    assert np.abs(sims[0].q[: model.m]).max() > 1e-6  # the base really moved
+    assert np.max(np.abs(sims[0]._x - sims[1]._x)) <= 1e-12 * max(1.0, np.max(np.abs(sims[1]._x)))
+    if name == "boom7":  # per logged column, as test_spatial_presets_agree (13 DOF, a stiff axial mode)
+        scale = np.maximum(1e-3, np.nanmax(np.abs(python_log), axis=0, initial=0.0))
+        assert np.nanmax(np.abs(native_log - python_log) / scale) <= 1e-9
+    else:
+        assert np.nanmax(np.abs(native_log - python_log)) <= 1e-12 * max(1.0, np.nanmax(np.abs(python_log)))
 
 
 @pytest.mark.parametrize("name", sorted(SCENARIOS))
@@ -293,7 +355,7 @@ def test_presets_agree(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     assert np.all(worst <= 1e-11), dict(zip(fast.log.columns, worst, strict=True))
 
 
-@pytest.mark.parametrize("name", ["boom7-track", "boom7-kick-on"])
+@pytest.mark.parametrize("name", ["boom7-track", "boom7-kick-on", "boom7-kick-off", "boom7-p2p"])
 def test_spatial_presets_agree(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """boom7 with S = forces only (law (15)'s S H_b G_b x_b' takes all six base velocities) and with all
     six rows: the native step and Python give the same log."""

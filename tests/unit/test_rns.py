@@ -16,6 +16,8 @@ from rns_viz.rns import (
     project_onto_rns,
     restricted_jacobian,
     rns_projector,
+    singularity_distance,
+    weighted_damped_pinv,
 )
 
 RNG = np.random.default_rng(3)
@@ -179,5 +181,26 @@ def test_multi_row_damped_inverse_equals_its_formula(boom7: FsmsModel) -> None:
         damped = damped_pinv(H_bm, 1e3, 0.1)  # damped everywhere: lambda > 0
         E = np.eye(m)
         plain = H_bm.T @ np.linalg.solve(H_bm @ H_bm.T + damped.damping**2 * E, E)
-        np.testing.assert_allclose(damped.inverse, plain, rtol=1e-12, atol=0)
+        np.testing.assert_allclose(
+            damped.inverse, plain, rtol=1e-12, atol=1e-13 * np.abs(plain).max()
+        )  # (G^-1 A)^T vs A^T G^-1 E
         assert damped.sigma_min == np.linalg.svd(H_bm, compute_uv=False)[-1]
+
+
+@pytest.mark.parametrize("rows", [1, 2, 6])
+def test_weighted_inverse_is_the_plain_one_undamped_and_damps_in_the_weighted_unit(rows: int) -> None:
+    """(W A)^+ W: away from rank loss A's own right inverse (row weights change no right inverse of full row
+    rank); sigma_min and lambda are W A's, and damped it is (W A)^T (W A (W A)^T + lambda^2 E)^-1 W."""
+    A = RNG.normal(size=(rows, 7))
+    weights = RNG.uniform(0.2, 3.0, rows)
+    free = weighted_damped_pinv(A, weights, 1e-6, 1e-6)
+    assert free.damping == 0.0
+    np.testing.assert_allclose(free.inverse, np.linalg.pinv(A), rtol=1e-10, atol=1e-12)
+    WA = weights[:, None] * A
+    assert free.sigma_min == pytest.approx(singularity_distance(A, weights), rel=1e-12)
+    assert singularity_distance(A, weights) == pytest.approx(np.linalg.svd(WA, compute_uv=False)[-1], rel=1e-12)
+    damped = weighted_damped_pinv(A, weights, 1e3, 0.5)
+    E = np.eye(rows)
+    expected = WA.T @ np.linalg.solve(WA @ WA.T + damped.damping**2 * E, E) * weights
+    assert damped.damping > 0
+    np.testing.assert_allclose(damped.inverse, expected, rtol=1e-10, atol=1e-14)

@@ -11,7 +11,7 @@ For a model with ``[arms]`` (trep2) the live session runs :class:`~rns_viz.contr
   plots show what compensation saves.
 
 :func:`compensation_state` says when the compensator cannot cancel: near its own singularity
-(sigma_min(S H_bm,2) small) or when the task asks more of it than its joints' velocity limits.
+(sigma_min(W S H_bm,2) small) or when the task asks more of it than its joints' velocity limits.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from rns_viz.control import ControlOutput, Gains, TaskSample
 from rns_viz.control.compensation import CompensatingLaw
 from rns_viz.live.operator.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
+from rns_viz.rns import singularity_distance
 
 WORKSPACE_MARGIN = 0.03  # fraction of the task arm's reach kept clear of its outer and inner boundary
 CANCEL_FLOOR = 1e-4  # kg m/s: below this task-arm momentum there is nothing to cancel
@@ -132,25 +133,26 @@ class TaskTarget(SmoothedTarget):
 
 
 def compensator_sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:
-    """S H_bm, sigma_min(S H_bm,2) of the compensator, sigma_min(J_1) of the task arm, the RNS dimension."""
+    """S H_bm, the compensator's distance to singularity sigma_min(W S H_bm,2) (kg m, rns.singularity_distance),
+    sigma_min(J_1) of the task arm, the RNS dimension."""
     H = model.mass_matrix(model.q(theta))[model.selected, model.m :]
     comp, task = model.arm_groups["compensating"].index, model.arm_groups["task"].index
     J1 = model.ee_jacobian(theta)[:, task]
-    sigma_2 = float(np.linalg.svd(H[:, comp], compute_uv=False)[-1])
+    sigma_2 = float(singularity_distance(H[:, comp], model.coupling_weights))
     return H, sigma_2, float(np.linalg.svd(J1, compute_uv=False)[-1]), model.n - H.shape[0]
 
 
 def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarray, warn_sigma: float) -> str | None:
     """Why the compensator cannot cancel the task arm's reaction now, or None when it does.
 
-    Near its singularity: sigma_min(S H_bm,2) below ``warn_sigma`` (kg m), where the damped inverse of
+    Near its singularity: sigma_min(W S H_bm,2) below ``warn_sigma`` (kg m), where the damped inverse of
     (9)-(10) gives up cancelling. Lagging: the residual coupling momentum exceeds CANCEL_RATIO of the
     task arm's. Beyond its speed: a compensator joint faster than its URDF velocity limit (rad/s).
     """
     if out is None:
         return None
     if out.sigma_hbm < warn_sigma:
-        return f"compensator near its singularity (σ_min(S H_bm,2) = {out.sigma_hbm:.2g} kg·m): it cannot cancel"
+        return f"compensator near its singularity (σ_min(W S H_bm,2) = {out.sigma_hbm:.2g} kg·m): it cannot cancel"
     L_task = float(out.extra.get("L_task", 0.0)) if out.extra else 0.0
     residual = float(np.linalg.norm(out.coupling_momentum))
     if L_task > CANCEL_FLOOR and residual > CANCEL_RATIO * L_task:

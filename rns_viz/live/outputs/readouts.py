@@ -9,12 +9,13 @@ import numpy as np
 from rns_viz.live.operator.dual_arm import compensator_sigmas, is_dual
 from rns_viz.live.published.snapshot import Readouts
 from rns_viz.model import FsmsModel
-from rns_viz.rns import null_vector, rns_projector, truncated_inverse
+from rns_viz.rns import null_vector, rns_projector, singularity_distance, truncated_inverse
 
 
 def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:
-    """S H_bm, its smallest singular value, the RNS-rank-th singular value of J-bar and the RNS dimension
-    (dual arms: the compensator's sigma_min(S H_bm,2) and the task arm's sigma_min(J_1) instead)."""
+    """S H_bm, its distance to singularity (kg m, rns.singularity_distance), the RNS-rank-th singular value
+    of J-bar and the RNS dimension
+    (dual arms: the compensator's sigma_min(W S H_bm,2) and the task arm's sigma_min(J_1) instead)."""
     if is_dual(model):
         return compensator_sigmas(model, theta)
     m = model.m
@@ -23,7 +24,8 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
     # the (n - r)-th singular value when the RNS has fewer directions than task rows: the truncation the
     # reference and Eq. (24) invert with (rns.truncated_inverse), so every readout of sigma(J-bar) agrees
     s_j = truncated_inverse(model.ee_jacobian(theta) @ rns_projector(H), rns_dim, 1e-12).sigma_min
-    return H, float(np.linalg.svd(H, compute_uv=False)[-1]), s_j if rns_dim >= 1 else float("nan"), rns_dim
+    s_h = float(singularity_distance(H, model.coupling_weights))
+    return H, s_h, s_j if rns_dim >= 1 else float("nan"), rns_dim
 
 
 def null_motion(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -36,7 +38,7 @@ def null_motion(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def coupling_sigma(model: FsmsModel, theta: np.ndarray) -> float:
-    """Smallest singular value of S H_bm at theta, kg m: the arm's authority over the base."""
+    """The distance to singularity of S H_bm at theta, sigma_min(W S H_bm) in kg m: the arm's grip on the base."""
     return _sigmas(model, np.asarray(theta, dtype=float))[1]
 
 

@@ -17,10 +17,8 @@ from rns_viz.paths import CouplingField, reactionless_reachable_set
 
 
 def arm_reach(model: FsmsModel) -> float:
-    """Arm reach (m): joint-to-joint distances plus the end-effector offset."""
-    pm = model.pin_model
-    links = sum(float(np.linalg.norm(pm.jointPlacements[j].translation)) for j in range(model.m + 2, pm.njoints))
-    return links + float(np.linalg.norm(pm.frames[model.ee_frame_id].placement.translation))
+    """Arm reach (m): joint-to-joint distances plus the end-effector offset (FsmsModel.arm_reach)."""
+    return model.arm_reach
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from rns_viz.model import FsmsModel
-from rns_viz.rns import lie_bracket, rns_projector
+from rns_viz.rns import lie_bracket, rns_projector, singularity_distance
 
 
 @dataclass(frozen=True)
@@ -86,8 +86,8 @@ def explore_rns(
     """Breadth-first sweep of the RNS distribution from ``theta0`` (see the module's notes).
 
     ``voxel`` (m): end-effector cell size and move length; ``max_step`` (rad): longest move;
-    configurations where sigma_min(S H_bm) < ``singular_sigma`` (kg m) or within ``margin`` (rad) of a
-    joint limit are not kept.
+    configurations nearer singularity than ``singular_sigma`` (kg m, rns.singularity_distance) or
+    within ``margin`` (rad) of a joint limit are not kept.
     """
     data = model.pin_model.createData()
     rows = model.task_rows
@@ -115,7 +115,7 @@ def explore_rns(
         if not len(cand):  # every move leaves the joint limits: the sweep is complete
             frontier = cand
             break
-        sig = np.linalg.svd(_rows(model, data, cand), compute_uv=False)[:, -1]
+        sig = singularity_distance(_rows(model, data, cand), model.coupling_weights)
         cand = cand[sig > singular_sigma]
         ee_c = model.ee_positions(cand, data) if len(cand) else np.empty((0, 3))
         new = []

@@ -121,6 +121,8 @@ class RunPair:
         :class:`ShadowDiverged` after the operated step succeeded.
         """
         if self._live is not None and joint is not None:
+            t = self.sim.t  # the samples are this step's: a law evaluated at its RK4 stages extrapolates them
+            joint, task = joint.taken_at(t), None if task is None else task.taken_at(t)
             for live in self._live:
                 live.follow(joint, task)
         out = self.sim.step()

@@ -15,6 +15,7 @@ import numpy as np
 
 from rns_viz.control import LawKind
 from rns_viz.model import FsmsModel
+from rns_viz.rns import singularity_distance
 
 
 @dataclass(frozen=True)
@@ -50,7 +51,8 @@ class Check:
         self.model = model
         H_b = float(model.mass_matrix(model.q(model.spec.default_configuration))[0, 0])
         self.period = 2 * math.pi * math.sqrt(H_b / float(model.K_b[0, 0]))  # s, the base's swing
-        self.sigma0 = float(np.linalg.svd(model.coupling_matrix(model.q(model.spec.default_configuration)))[1][-1])
+        theta0 = model.spec.default_configuration  # the readout's distance to singularity there (kg m)
+        self.sigma0 = float(singularity_distance(model.coupling_matrix(model.q(theta0)), model.coupling_weights))
         self._epoch: int | None = None
         self.done = False
 

@@ -118,7 +118,7 @@ class SuppressedVersusShadow(Check):
 
 
 class WeakestPoint(Check):
-    """Hold the arm where sigma_min(S H_bm) is at most 65 % of its value at the start configuration."""
+    """Hold the arm where sigma_min(W S H_bm) is at most 65 % of its value at the start configuration."""
 
     def update(self, v: RunView) -> None:
         self.ratio = v.sigma_hbm / self.sigma0
@@ -126,7 +126,7 @@ class WeakestPoint(Check):
 
     def progress(self) -> Progress:
         ratio = getattr(self, "ratio", 1.0)
-        return Progress(self.done, f"σ_min(S H_bm) here is {ratio:.0%} of its value at the start.")
+        return Progress(self.done, f"σ_min(W S H_bm) here is {ratio:.0%} of its value at the start.")
 
 
 class CyclicAndKick(Check):
@@ -254,9 +254,9 @@ TREP_LESSONS = (
     Lesson(
         "Where suppression is weakest",
         "Eq. (30): H_bm⁺",
-        "The smaller the distance to singularity σ_min(S H_bm), the faster the joints must turn for the same "
+        "The smaller the distance to singularity σ_min(W S H_bm), the faster the joints must turn for the same "
         "push on the base; where it vanishes the arm has no authority over the base at all.",
-        "Move along the path to where σ_min(S H_bm) (readout) is at most 65 % of its start value, and stop there.",
+        "Move along the path to where σ_min(W S H_bm) (readout) is at most 65 % of its start value, and stop there.",
         LessonStart("trep", "velocity", True),
         WeakestPoint,
     ),

@@ -4,7 +4,7 @@
 for each, the arm's pose as the polyline base-frame joint positions -> end effector, what the scene
 draws. For one base row (TREP, the 3R) the set is a few isolated poses with every link along the
 deflection axis; the drawn pose is that configuration, so each drawn point carries its sigma_min.
-:func:`rank_inset` gives the same configurations in a plane of two joints, over sigma_min(S H_bm),
+:func:`rank_inset` gives the same configurations in a plane of two joints, over sigma_min(W S H_bm),
 for the joint-space inset.
 """
 
@@ -36,7 +36,7 @@ class RankOverlay:
 
     theta: np.ndarray  # (K, n) configurations, rad
     poses: np.ndarray  # (K, n + 1, 3) joint positions then the end effector, base frame, m
-    sigma_min: np.ndarray  # (K,) sigma_min(S H_bm) there, kg m
+    sigma_min: np.ndarray  # (K,) sigma_min(W S H_bm) there, kg m
     scale: float  # the largest ||S H_bm|| over the search grid (the most coupled direction), kg m
 
 
@@ -75,7 +75,7 @@ INSET_POINTS = {2: 61, 3: 41}  # grid nodes per axis of the sigma_min field (one
 
 @dataclass(frozen=True)
 class RankInset:
-    """The joint-space picture of rank loss: a plane of two joints, sigma_min(S H_bm) over it, the rank-loss
+    """The joint-space picture of rank loss: a plane of two joints, sigma_min(W S H_bm) over it, the rank-loss
     configurations and where they fall in the plane.
 
     TREP: the whole (theta_1, theta_2) plane, every rank-loss pose in it. The 3R: the (theta_2, theta_3)
@@ -88,7 +88,7 @@ class RankInset:
     columns: tuple[int, int]  # the joints on the axes (indices into theta)
     fixed: float | None  # rad: theta_1 of the 3R's slice, None for TREP
     axis: np.ndarray  # (P,) rad, both axes
-    sigma: np.ndarray  # (P, P) sigma_min(S H_bm) / scale, [i along columns[0], j along columns[1]]
+    sigma: np.ndarray  # (P, P) sigma_min(W S H_bm) / scale, [i along columns[0], j along columns[1]]
     theta: np.ndarray  # (K, n) the rank-loss configurations drawn (each checked: sigma_min <= 1e-9 scale)
     in_plane: np.ndarray  # (K,) bool: the configuration lies in the drawn plane (filled), else a ring
     scale: float  # kg m: the most coupled ||S H_bm|| of the search

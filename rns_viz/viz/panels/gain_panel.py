@@ -285,6 +285,6 @@ def authority_text(view: GainView, on_path: bool) -> str:
     r = auth.base_decay_rate
     return (
         f"**Authority** {where}, coloured as the base mode's map: σ_b {np.min(r):.3g} … {np.max(r):.3g} 1/s "
-        "at the gains in force — flat except where the distance to singularity σ_min(S H_bm) is small, where "
+        "at the gains in force — flat except where the distance to singularity σ_min(W S H_bm) is small, where "
         "suppression fades."
     )

@@ -78,9 +78,10 @@ def readouts_html(snap: Snapshot) -> str:
     err = si(r.ee_error, "m", floor=1e-9)
     rows = [
         (
-            "distance to singularity σ<sub>min</sub>(S H<sub>bm</sub>)",
+            "distance to singularity σ<sub>min</sub>(W S H<sub>bm</sub>)",
             _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
-            "how much grip the arm has on the base; near 0 it can neither push nor damp it",
+            "distance to singularity: how much grip the arm has on the base, near 0 it can neither push nor damp "
+            "it; kg·m, a turning base's moment rows (kg·m²) divided by the arm's reach",
         ),
         (
             "σ(J̄)",
@@ -122,7 +123,7 @@ def dual_rows(snap: Snapshot) -> list[tuple[str, str, str]]:
         cancel = f'<span style="color:{BAD_COLOUR};font-weight:600">{r.cancel}</span>'
     return [
         (
-            "distance to singularity σ<sub>min</sub>(S H<sub>bm,2</sub>)",
+            "distance to singularity σ<sub>min</sub>(W S H<sub>bm,2</sub>)",
             _value(r.sigma_hbm, r.warn_hbm, "kg·m"),
             "the compensating arm's grip on the base; near 0 (its links along the beam's swing) it cannot cancel",
         ),

@@ -1,6 +1,6 @@
 """The joint-space inset of rank loss: a small picture of a plane of two joints under the scene toggle.
 
-Why an image and not a uPlot chart: the picture is a field (sigma_min(S H_bm) over the plane, log
+Why an image and not a uPlot chart: the picture is a field (sigma_min(W S H_bm) over the plane, log
 colour) with markers, which a uPlot line chart cannot draw. The field, the axes and the rank-loss
 markers are drawn once per plane with matplotlib (Agg) into an RGB array, in a thread of its own
 (0.1-0.3 s: never in the render thread); each refresh (with the text, 5 Hz) only stamps the arm's
@@ -31,7 +31,7 @@ DOT_COLOUR = (31, 111, 209)  # the arm now: the charts' blue
 MARK_COLOUR = "#c87800"  # amber, as the overlay's poses
 INSET_TEXT = (
     "Amber: where S H_bm loses rank. "
-    "Blue dot: the arm now. Colour: σ_min(S H_bm) relative to its largest, dark where the joints barely push "
+    "Blue dot: the arm now. Colour: σ_min(W S H_bm) relative to its largest, dark where the joints barely push "
     "the base. "
 )
 
