@@ -6,7 +6,6 @@ Bad arguments give one clear line on stderr and exit status 2, never a traceback
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import sys
@@ -124,7 +123,9 @@ def cmd_info(args: argparse.Namespace) -> None:
 
 
 def cmd_paths(args: argparse.Namespace) -> None:
+    from rns_viz.csvio import write_csv
     from rns_viz.paths import path_family
+    from rns_viz.sim.log import arm_units
 
     model = _load_model(args.model)
     out = Path(args.csv)
@@ -134,14 +135,11 @@ def cmd_paths(args: argparse.Namespace) -> None:
     except ValueError as exc:
         handle.close()
         raise CliError(str(exc)) from None
+    units = ["index", "rad", *[u.position for u in arm_units(model)], "m", "m", "m"]
+    columns = ["path", "s", *[f"theta_{i + 1}" for i in range(model.n)], "ee_x", "ee_y", "ee_z"]
+    rows = [np.column_stack((np.full(len(p.s), i), p.s, p.theta, p.ee)) for i, p in enumerate(paths)]
     with handle:
-        writer = csv.writer(handle)
-        writer.writerow(["path", "s", *[f"theta_{i + 1}" for i in range(model.n)], "ee_x", "ee_y", "ee_z"])
-        for index, path in enumerate(paths):
-            for s, theta, ee in zip(path.s, path.theta, path.ee, strict=True):
-                writer.writerow(
-                    [index, repr(float(s)), *(repr(float(t)) for t in theta), *(repr(float(e)) for e in ee)]
-                )
+        write_csv(handle, columns, units, np.concatenate(rows))
     ends = sorted({p.end for p in paths})
     print(f"wrote {len(paths)} paths ({sum(len(p.s) for p in paths)} points; ends: {', '.join(ends)}) to {out}")
 

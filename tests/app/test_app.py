@@ -15,6 +15,7 @@ import time
 import numpy as np
 import pytest
 
+from rns_viz.csvio import read_csv
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, serve, start_app
@@ -261,10 +262,10 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
 def test_log_download_has_the_step_log_columns(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     s.advance(0.5)
-    text = s.log_csv().decode()
-    header, *rows = text.strip().splitlines()
-    assert header.split(",") == s.state.runs.sim.log.columns
-    assert len(rows) == 500 and all(math.isfinite(float(x)) for x in rows[-1].split(",")[:5])
+    table = read_csv(s.log_csv())
+    log = s.state.runs.sim.log
+    assert list(table.columns) == log.columns and list(table.units) == log.units
+    assert len(table.rows) == 500 and all(math.isfinite(x) for x in table.rows[-1, :5])
     client.click(uuid(trep_app.gui.download))
     wait_until(lambda: client.types["FileTransferStartDownload"] >= 1, 10.0, "the CSV download to start")
 

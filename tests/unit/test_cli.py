@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 import subprocess
 import sys
@@ -11,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rns_viz.csvio import read_csv
 from tests.support.oracles.closed_forms import trep_ee
 from tests.support.repo import ASSETS
 
@@ -35,14 +35,12 @@ def test_paths_csv(tmp_path: Path) -> None:
     out = tmp_path / "paths.csv"
     result = run("paths", "--model", "trep", "--count", "6", "--csv", str(out))
     assert result.returncode == 0, result.stderr
-    with out.open() as handle:
-        rows = list(csv.DictReader(handle))
-    assert list(rows[0]) == ["path", "s", "theta_1", "theta_2", "ee_x", "ee_y", "ee_z"]
-    assert {int(r["path"]) for r in rows} == set(range(6))
-    for r in rows[::7]:
-        theta = np.array([float(r["theta_1"]), float(r["theta_2"])])
-        ee = np.array([float(r["ee_x"]), float(r["ee_y"]), float(r["ee_z"])])
-        np.testing.assert_allclose(ee, trep_ee(theta), atol=1e-12)
+    table = read_csv(out)
+    assert table.columns == ("path", "s", "theta_1", "theta_2", "ee_x", "ee_y", "ee_z")
+    assert table.units == ("index", "rad", "rad", "rad", "m", "m", "m")
+    assert set(table.column("path")) == set(range(6))
+    for r in table.rows[::7]:
+        np.testing.assert_allclose(r[4:7], trep_ee(r[2:4]), atol=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from rns_viz.csvio import csv_text
 from rns_viz.live.explorer.gain_explorer import GainView
 from rns_viz.live.loop import commands as c
 from rns_viz.live.loop.state import LiveState
@@ -95,15 +96,12 @@ class Session:
         return list(self._latencies)
 
     def log_csv(self, last_seconds: float | None = None) -> bytes:
-        """The operated run's step log as CSV (StepLog's columns), the newest ``last_seconds``."""
-        with self._lock:
+        """The operated run's step log as CSV (rns_viz.csvio: units in the header, 17 significant digits),
+        the newest ``last_seconds``."""
+        with self._lock:  # the rows copied under the lock, written out after it
             log = self.state.runs.sim.log
-            columns = list(log.columns)
             rows = log.array(None if last_seconds is None else round(last_seconds / self.dt))
-        lines = [",".join(columns)]
-        fmt = ",".join(["%.10g"] * len(columns))
-        lines.extend(fmt % tuple(row) for row in rows)
-        return ("\n".join(lines) + "\n").encode()
+        return csv_text(log.columns, log.units, rows).encode()
 
     def recording(self, seconds: float) -> Recording | None:
         """The newest ``seconds`` (at most 60) of the run as an immutable recording (None: nothing yet).
