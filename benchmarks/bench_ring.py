@@ -13,15 +13,15 @@ Printed: the median over the rounds, µs, of both trees, and the ratio this / ot
 
 from __future__ import annotations
 
-import argparse
 import json
-import os
-import statistics
-import subprocess
 import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from tree_rounds import main
 
 
 def measure(calls: int) -> None:
@@ -62,49 +62,5 @@ def measure(calls: int) -> None:
     print(json.dumps(figures))
 
 
-def run(tree: Path, calls: int) -> dict[str, float]:
-    env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}
-    out = subprocess.run(
-        [sys.executable, str(Path(__file__).resolve()), "--measure", "--calls", str(calls)],
-        cwd=tree,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=True,
-    )
-    return json.loads(out.stdout.strip().splitlines()[-1])
-
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("other", type=Path, nargs="?", help="root of another checkout of rns_viz")
-    parser.add_argument("--rounds", type=int, default=7)
-    parser.add_argument("--calls", type=int, default=20000)
-    parser.add_argument("--measure", action="store_true", help=argparse.SUPPRESS)
-    args = parser.parse_args()
-    if args.measure:
-        measure(args.calls)
-        return
-    trees = {"this": Path(__file__).resolve().parent.parent}
-    if args.other is not None:
-        trees["other"] = args.other.resolve()
-    found: dict[str, dict[str, list[float]]] = {tree: {} for tree in trees}
-    load = os.getloadavg()[0]
-    for r in range(args.rounds):
-        for tree in list(trees) if r % 2 == 0 else list(reversed(trees)):
-            for figure, value in run(trees[tree], args.calls).items():
-                found[tree].setdefault(figure, []).append(value)
-    print(f"ring buffers, {args.rounds} rounds; load before {load:.2f}, after {os.getloadavg()[0]:.2f}")
-    for tree, path in trees.items():
-        print(f"{tree}: {path}")
-    ratio = "     ratio" if len(trees) == 2 else ""
-    print(f"{'µs per call (median)':<24}" + "".join(f"{t:>10}" for t in trees) + ratio)
-    for figure in found["this"]:
-        values = [statistics.median(found[t][figure]) for t in trees]
-        ratio = f"{values[0] / values[1]:>10.3f}" if len(values) == 2 else ""
-        print(f"{figure:<24}" + "".join(f"{v:>10.3f}" for v in values) + ratio)
-
-
 if __name__ == "__main__":
-    main()
+    main(__file__, __doc__ or "", measure, rounds=7, calls=20000, unit="µs per call", scale=1.0)
