@@ -152,13 +152,16 @@ class StepLog(Ring):
         super().clear()
         self._completed = 0
 
+    def newest(self, k: int | None = None, column: int | None = None) -> np.ndarray:
+        """As :meth:`Ring.newest`, the derived columns filled first."""
+        self._complete_rows()
+        return super().newest(k, column)
+
     def array(self, last: int | None = None) -> np.ndarray:
         """The rows in time order (a copy); ``last`` limits to the newest rows."""
-        self._complete_rows()
         return self.newest(last)
 
     def column(self, name: str, last: int | None = None) -> np.ndarray:
-        self._complete_rows()
         return self.newest(last, self.index[name])
 
     def _complete_rows(self) -> None:
