@@ -195,21 +195,16 @@ class _Helper:
     def _submit(self, request: bytes) -> Future[bytes]:
         """The future of ``request`` in the helper, which is started first if there is none or it died
         while idle (not this job's doing, so the job gets a new one)."""
-        for _ in range(2):
-            if self.pool is not None and not all(p.is_alive() for p in self.processes):
-                self.close()
-            if self.pool is None:
-                self.pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
-                before = set(active_children())
-                with _main_script_hidden():  # the helper is spawned by its first submit
-                    future = self.pool.submit(_compute, request)
-                self.processes = [p for p in active_children() if p not in before]
-                return future
-            try:
-                return self.pool.submit(_compute, request)
-            except BrokenExecutor:  # found broken before is_alive said so
-                self.close()
-        raise AssertionError("unreachable: a new pool takes a job")
+        if self.pool is not None and not all(p.is_alive() for p in self.processes):
+            self.close()
+        if self.pool is not None:
+            return self.pool.submit(_compute, request)
+        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
+        before = set(active_children())
+        with _main_script_hidden():  # the helper is spawned by its first submit
+            future = self.pool.submit(_compute, request)
+        self.processes = [p for p in active_children() if p not in before]
+        return future
 
     def close(self) -> None:
         """Let the helper go: it ends once a job in flight is done (that job's result is dropped)."""
