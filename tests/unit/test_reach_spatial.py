@@ -10,9 +10,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from rns_viz.integrability import bracket_rank
 from rns_viz.live.reach.region import arm_reach, build_reach_region
-from rns_viz.live.reach.spatial import bracket_rank, explore_rns
 from rns_viz.model import FsmsModel
+from rns_viz.paths import explore_rns
 
 
 @pytest.fixture(scope="module")
