@@ -81,8 +81,7 @@ def test_one_base_row_in_floats_equals_the_array_form(trep: FsmsModel) -> None:
         q, v = trep.q(rng.uniform(-2, 2, 2), rng.normal(size=1) * 1e-3), rng.normal(size=3) * 0.2
         cp = law.coupling(q, v)
         assert cp.row is not None
-        y_row = base_rows_demand(cp, G_B, G_M)
-        cp.row = None  # the same coupling through the array form
-        y = base_rows_demand(cp, G_B, G_M)
+        y_row = base_rows_demand(cp, G_B, G_M, in_floats=True)
+        y = base_rows_demand(cp, G_B, G_M)  # the same coupling through the array form
         assert isinstance(y_row, float) and y.shape == (1,)
         assert y_row == pytest.approx(float(y[0]), rel=1e-14, abs=1e-18)
