@@ -241,6 +241,13 @@ def project_onto_rns(u: np.ndarray, H_bm: np.ndarray, H_bm_pinv: np.ndarray | No
     return u - H_bm_pinv @ (H_bm @ u)
 
 
+def rns_basis(H_bm: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of the reaction null space N(S H_bm) of full row rank r: (n, n - r), or (..., n, n - r)
+    for a stack; the SVD's right singular vectors beyond the rows (the columns span what P_RNS projects onto)."""
+    Vt = np.linalg.svd(H_bm)[2]
+    return np.swapaxes(Vt[..., H_bm.shape[-2] :, :], -1, -2)
+
+
 def rk4_along(
     field: Callable[[Any, np.ndarray], np.ndarray],
     s: Any,

@@ -13,7 +13,7 @@ import numpy as np
 
 from rns_viz.model import FsmsModel
 from rns_viz.paths.field import TWO_PI, CouplingField, periodic_joints
-from rns_viz.rns import singularity_distance
+from rns_viz.rns import rns_basis, singularity_distance
 
 
 @dataclass(frozen=True)
@@ -54,9 +54,8 @@ def reactionless_reachable_set(
     frontier = start
     while len(frontier) and len(accepted) < max_points:
         H, _ = field.rows_at(frontier)
-        _, _, Vt = np.linalg.svd(H)
         r = H.shape[1]
-        basis = np.transpose(Vt[:, r:, :], (0, 2, 1))  # (F, n, k) orthonormal null-space bases
+        basis = rns_basis(H)  # (F, n, k) orthonormal null-space bases
         steps = np.concatenate([basis, -basis], axis=2) * spacing
         candidates = (frontier[:, :, None] + steps).transpose(0, 2, 1).reshape(-1, model.n)
         candidates = field.project(candidates, np.broadcast_to(level, (len(candidates), r)).copy())

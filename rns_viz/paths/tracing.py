@@ -231,7 +231,7 @@ def nearby_seeds(model: FsmsModel, theta: np.ndarray, count: int, spread: float 
     the same call gives the same family; seeds are clipped to the joint limits.
     """
     theta = np.asarray(theta, dtype=float)
-    rows = np.linalg.svd(model.coupling_matrix(model.q(theta)))[2][: len(model.selected)]  # range of H^T
+    rows = np.linalg.svd(model.coupling_at(theta))[2][: len(model.selected)]  # range of H^T
     directions = np.random.default_rng(0).normal(size=(count, len(rows)))
     directions /= np.linalg.norm(directions, axis=1)[:, None]
     return np.clip(theta + spread * directions @ rows, model.lower, model.upper)

@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from rns_viz.model import FsmsModel
 from rns_viz.paths.field import CouplingField
-from rns_viz.rns import project_onto_rns, rk4_along, singularity_distance
+from rns_viz.rns import project_onto_rns, rk4_along, rns_basis, singularity_distance
 
 
 @dataclass(frozen=True)
@@ -73,9 +73,7 @@ def explore_rns(
     visited = {tuple(np.floor(ee[0][rows] / voxel).astype(int))}
     thetas, points, frontier = [start[0]], [ee[0]], start
     while len(frontier) and len(thetas) < max_points:
-        H = coupling.rows_at(frontier)[0]
-        Vt = np.linalg.svd(H)[2]
-        N = np.transpose(Vt[:, -k:, :], (0, 2, 1))  # (F, n, k) orthonormal bases of N(S H_bm)
+        N = rns_basis(coupling.rows_at(frontier)[0])  # (F, n, k) orthonormal bases of N(S H_bm)
         _, J = _jacobians(model, data, frontier)
         _, sj, Wt = np.linalg.svd(J[:, rows] @ N)  # directions of the RNS that move the hand
         d = min(k, len(rows))

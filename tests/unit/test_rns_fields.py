@@ -16,7 +16,14 @@ from scipy.integrate import solve_ivp
 
 from rns_viz.control.reference import along_path
 from rns_viz.model import FsmsModel
-from rns_viz.rns import null_vector, project_onto_rns, rk4_along, rns_projector, singularity_distance
+from rns_viz.rns import (
+    null_vector,
+    project_onto_rns,
+    rk4_along,
+    rns_basis,
+    rns_projector,
+    singularity_distance,
+)
 
 RNG = np.random.default_rng(29)
 
@@ -86,7 +93,8 @@ def test_rk4_steps_a_stack_of_curves_in_lock_step(trep: FsmsModel) -> None:
 # -- P_RNS of one or many -------------------------------------------------------------------------
 def test_the_projector_of_a_stack_is_the_stack_of_projectors(boom7: FsmsModel) -> None:
     """boom7 with forces only (r = 3) at K configurations, and one rank-deficient member (a repeated row):
-    each P of the stack is that configuration's own Moore-Penrose P_RNS, applied or formed."""
+    each P of the stack is that configuration's own Moore-Penrose P_RNS, applied or formed, and the
+    orthonormal bases of the RNS span it."""
     model = boom7.with_selection([1, 1, 1, 0, 0, 0])
     thetas = RNG.uniform(model.lower, model.upper, (6, model.n))
     H = np.array([model.coupling_at(th) for th in thetas])
@@ -98,6 +106,13 @@ def test_the_projector_of_a_stack_is_the_stack_of_projectors(boom7: FsmsModel) -
         np.testing.assert_allclose(applied[k], project_onto_rns(u[k], H[k]), atol=1e-15)
         np.testing.assert_allclose(applied[k], P[k] @ u[k], atol=1e-13)
         np.testing.assert_allclose(H[k] @ applied[k], 0.0, atol=1e-12)
+    basis = rns_basis(H)  # (K, n, n - r): orthonormal, in the RNS, spanning what P projects onto
+    assert basis.shape == (6, model.n, model.n - 3)
+    np.testing.assert_allclose(
+        np.swapaxes(basis, 1, 2) @ basis, np.broadcast_to(np.eye(model.n - 3), (6, 4, 4)), atol=1e-14
+    )
+    np.testing.assert_allclose(basis @ np.swapaxes(basis, 1, 2), P, atol=1e-13)
+    np.testing.assert_array_equal(basis[0], rns_basis(H[0]))
     deficient = H.copy()
     deficient[2, 2] = deficient[2, 1]  # rank 2: its P keeps one direction more
     P_def = rns_projector(deficient)
