@@ -35,7 +35,6 @@ from rns_viz.control.reference import path_integral_to
 from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import CyclicUbar, QuinticUbar
-from rns_viz.rns import null_vector
 from rns_viz.sim import ForcePulse, Simulator
 
 # "An arbitrary external force" (Sec. VII-D): the kicks of rns_viz.defaults (why these sizes: there).
@@ -212,7 +211,7 @@ def boom7_kick(suppress: bool, name: str = "boom7") -> Simulator:
 def boom7_path_reference(model: FsmsModel) -> PathReference:
     """theta_ref' = n u-bar along the r = 6 reactionless path from theta_0, quintic u-bar (Eq. 30's integral)."""
     theta0 = model.spec.default_configuration
-    sigma = BOOM7_PATH_ARC / float(np.linalg.norm(null_vector(model.coupling_matrix(model.q(theta0)))))
+    sigma = BOOM7_PATH_ARC / float(np.linalg.norm(model.null_vector(theta0)))
     return PathReference(model, theta0, QuinticUbar(sigma, BOOM7_MOVE_S, start=BOOM7_START_S))
 
 

@@ -16,10 +16,9 @@ import pytest
 from rns_viz.control import Gains, InvalidGain, JointSample, TaskSample
 from rns_viz.live.loop import commands as c
 from rns_viz.live.operator.operator import UNCHANGED, InputRefused, Operator
-from rns_viz.live.reach.path_table import build_path_table
 from rns_viz.live.runs.run_pair import LawChoice, RunPair
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField
+from rns_viz.paths import CouplingField, build_path_table
 from rns_viz.rns import null_vector
 
 DT = 1e-3

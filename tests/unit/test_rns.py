@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from rns_viz import rns
+from rns_viz.integrability import check_integrability
 from rns_viz.model import FsmsModel
 from rns_viz.rns import (
-    check_integrability,
     damped_pinv,
     null_vector,
     project_onto_rns,

@@ -17,10 +17,11 @@ import scipy.linalg
 from rns_viz.control import AccelerationLaw, Gains, JointQuintic, JointServo, TaskQuintic, TrackEndEffector
 from rns_viz.control.common import CouplingEvaluator
 from rns_viz.defaults import defaults_for
+from rns_viz.integrability import check_integrability
 from rns_viz.model import FsmsModel
 from rns_viz.params import BUNDLED_MODELS, MODEL_NAMES, ModelFileError
 from rns_viz.paths import nearby_seeds, path_family, trace_paths
-from rns_viz.rns import check_integrability, null_vector, rns_projector, singularity_distance
+from rns_viz.rns import null_vector, rns_projector, singularity_distance
 from rns_viz.scenarios import (
     ALL_SCENARIOS,
     BOOM7_DISPLACEMENT,

@@ -34,10 +34,9 @@ import numpy as np
 
 from rns_viz.analysis import GainMap, LinearLoop, linearise, loops_along, map_of
 from rns_viz.control import LawKind
-from rns_viz.live.reach.path_table import PathTable, build_path_table
 from rns_viz.live.reach.region import ReachRegion, build_reach_region
 from rns_viz.model import FsmsModel
-from rns_viz.paths import path_family
+from rns_viz.paths import PathTable, build_path_table, path_family
 
 _models: dict[str, FsmsModel] = {}
 

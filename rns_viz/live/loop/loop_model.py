@@ -12,13 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rns_viz.integrability import check_integrability
 from rns_viz.live.operator.operator import InputRefused
 from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.divergence_guard import Bounds
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_key, model_source, spec_for_key
 from rns_viz.paths import CouplingField
-from rns_viz.rns import check_integrability
 
 
 @dataclass(frozen=True)
@@ -52,7 +52,7 @@ def key_of(model: FsmsModel) -> str:
 
 def integrability_note(model: FsmsModel, theta: np.ndarray) -> str:
     """Frobenius test of the RNS distribution at ``theta`` (Lie brackets of the columns of P_RNS), in words."""
-    test = check_integrability(lambda th: model.coupling_matrix(model.q(th)), np.asarray(theta, dtype=float))
+    test = check_integrability(model.coupling_at, np.asarray(theta, dtype=float))
     if test.integrable:
         return f"Lie brackets here: the RNS distribution is integrable (residual {test.max_residual:.1e})."
     return (

@@ -12,10 +12,9 @@ import numpy as np
 from rns_viz.live.jobs.background import Background
 from rns_viz.live.operator.dual_arm import is_dual
 from rns_viz.live.published.snapshot import Overlays
-from rns_viz.live.reach.path_table import PathTable
 from rns_viz.live.reach.region import ReachRegion
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField
+from rns_viz.paths import CouplingField, PathTable
 
 
 class Geometry:

@@ -25,13 +25,13 @@ from rns_viz.live.operator.dual_arm import refuse_other_laws
 from rns_viz.live.operator.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs.step_outputs import Outputs
 from rns_viz.live.published.snapshot import Level, Notice, ReplayView, Settings, Snapshot
-from rns_viz.live.reach.path_table import PathTable
 from rns_viz.live.runs.divergence_guard import GUARD_EVERY
 from rns_viz.live.runs.kicks import kick_pulse
 from rns_viz.live.runs.run_pair import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.teaching.lesson_run import OBSERVE_EVERY, LessonRun, run_view
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_source
+from rns_viz.paths import PathTable
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path

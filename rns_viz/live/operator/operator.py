@@ -28,9 +28,9 @@ from rns_viz.control import JointSample, TaskSample
 from rns_viz.live.operator.dual_arm import TaskTarget, is_dual
 from rns_viz.live.operator.moving_references import PathFollower, ResolvedRate, SigmaMotion
 from rns_viz.live.published.snapshot import OrientationView
-from rns_viz.live.reach.path_table import PathTable
 from rns_viz.live.reach.region import ReachRegion
 from rns_viz.model import FsmsModel
+from rns_viz.paths import PathTable
 from rns_viz.profiles import QuinticSegment
 from rns_viz.scenarios import FIG11_FAST_S
 

@@ -18,8 +18,7 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
     (dual arms: the compensator's sigma_min(W S H_bm,2) and the task arm's sigma_min(J_1) instead)."""
     if is_dual(model):
         return compensator_sigmas(model, theta)
-    m = model.m
-    H = model.mass_matrix(model.q(theta))[model.selected, m:]
+    H = model.coupling_at(theta)
     rns_dim = model.n - H.shape[0]
     # the (n - r)-th singular value when the RNS has fewer directions than task rows: the truncation the
     # reference and Eq. (24) invert with (rns.truncated_inverse), so every readout of sigma(J-bar) agrees
@@ -31,7 +30,7 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
 def null_motion(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For a 1-D RNS at theta: n (kg m, Eq. 27) and the end-effector velocity J n it makes (3-vector,
     base frame, m/s per unit u-bar), the arrow the teaching view draws."""
-    n = null_vector(model.coupling_matrix(model.q(theta)))
+    n = model.null_vector(theta)
     jn = np.zeros(3)
     jn[model.task_rows] = model.ee_jacobian(theta) @ n
     return n, jn

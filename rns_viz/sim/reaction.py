@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from rns_viz.model import FsmsModel
-from rns_viz.sim import Plant
+from rns_viz.sim.plant import Plant
 
 
 class ReactionProbe:

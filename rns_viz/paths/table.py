@@ -1,7 +1,7 @@
 """The current reactionless path of a 1-D RNS as a table over the path integral sigma (Eq. 30).
 
 sigma is the integral of u-bar dt: along the path d theta / d sigma = n(theta) (Eq. 27, unnormalised,
-kg m), so sigma has units 1/(kg m). The table is traced by :func:`rns_viz.paths.trace_paths`
+kg m), so sigma has units 1/(kg m). The table is traced by :func:`rns_viz.paths.tracing.trace_paths`
 (arc length s in joint space) and re-parametrised with d sigma = ds / |n|; sigma = 0 at the seed.
 """
 
@@ -12,10 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField, trace_paths
+from rns_viz.paths.field import TWO_PI, CouplingField
+from rns_viz.paths.tracing import trace_paths
 from rns_viz.rns import null_vector
-
-TWO_PI = 2.0 * np.pi
 
 
 @dataclass(frozen=True)
@@ -91,7 +90,7 @@ def build_path_table(model: FsmsModel, seed: np.ndarray, ds: float = 0.02) -> Pa
     path = trace_paths(model, seed[None], ds=ds)[0]
     field = CouplingField(model)
     H, _ = field.rows_at(path.theta)
-    norms = np.array([np.linalg.norm(null_vector(h)) for h in H])
+    norms = np.array([np.linalg.norm(n) for n in null_vector(H)])  # |n| (kg m) along the path
     steps = np.diff(path.s) * 0.5 * (1.0 / norms[1:] + 1.0 / norms[:-1])
     sigma = np.concatenate([[0.0], np.cumsum(steps)])
     delta = (path.theta - seed + np.pi) % TWO_PI - np.pi
