@@ -1,4 +1,4 @@
-"""boom7's boom against a finite-element model of the same tube (tests/oracles/tube_fe.py).
+"""boom7's boom against a finite-element model of the same tube (tests/support/oracles/tube_fe.py).
 
 The six tip coordinates carry the tube by Guyan's static condensation: the tip stiffness K_b
 (boom7.toml) and the mass of the static deflection shapes (boom7.urdf, link boom_tube). A
