@@ -50,8 +50,9 @@ class LiveState:
         self.paused = False
         self.diverged: str | None = None
         self.replay: ReplayView | None = None  # a replay shown while the simulation waits (live/loop/replay_mode.py)
-        self.settings = Settings.defaults(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
+        self._use_model(model)  # a bad model file raises here
+        self.settings = Settings.defaults(self.model, shadow, pacer.speed)
         self.lesson: LessonRun | None = None
         self.kicks_sent = self.targets_moved = 0  # kicks, dragged targets moved onto the path / into the set
         self._preset_paused = False  # the preset being built starts paused
@@ -103,7 +104,7 @@ class LiveState:
     def _restart_bookkeeping(self) -> None:
         """A new epoch (reset, model switch, preset, selection); a lesson goes on only on its own model."""
         self.epoch += 1
-        if self.lesson is not None and model_source(self.model.name) != self.lesson.model:
+        if self.lesson is not None and model_source(self.model.name) != self.lesson.home:
             self.lesson = None
         self.settings_version += 1
         self.target_version += 1
@@ -135,7 +136,7 @@ class LiveState:
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
-        defaults = Settings.defaults(self.model.name, st.shadow, st.speed)
+        defaults = Settings.defaults(self.model, st.shadow, st.speed)
         self.settings = replace(defaults, law=choice.kind, gains=choice.gains, suppress=choice.suppress, preset=name)
         self._restart_bookkeeping()
         self.paused = self._preset_paused
@@ -200,7 +201,7 @@ class LiveState:
                 self.pacer.set_speed(speed, self.runs.t)
                 self.settings = replace(st, speed=speed)
             case c.Kick(peak=peak, direction=direction):
-                duration = defaults_for(st.model).kick_duration_s
+                duration = defaults_for(self.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m, direction))
                 self.kicks_sent += 1
                 self.explorer.kicked(self.runs.t, st.suppress)
@@ -214,7 +215,7 @@ class LiveState:
             case c.SetLaw(law=law):
                 refuse_other_laws(self.model, law)
                 self._gain_memory[(st.model, st.law)] = st.gains
-                gains = self._gain_memory.get((st.model, law), defaults_for(st.model).gains_for(law))
+                gains = self._gain_memory.get((st.model, law), defaults_for(self.model).gains_for(law))
                 self.settings = replace(st, law=law, gains=gains)
                 if self.operator is None:
                     self._go_live()
@@ -254,7 +255,7 @@ class LiveState:
                 self.target_version += 1
             case c.SwitchModel(model=name):
                 self._use_model(name)  # a bad file stops here, the running model untouched
-                self.settings = Settings.defaults(name, st.shadow, st.speed)
+                self.settings = Settings.defaults(self.model, st.shadow, st.speed)
                 self.start_live(name)
             case c.SetSelection(flags=flags):  # the same system with another S, at rest where the arm is
                 key, note = selection_key(self.model, flags, self.runs.theta)

@@ -30,7 +30,7 @@ def target_text(model: FsmsModel) -> str:
 def kick_hint(model: FsmsModel) -> str:
     """The kick slider's hint: the pulse of this model (its duration) and, for a base of several
     coordinates, where its direction is chosen."""
-    duration = defaults_for(model.name).kick_duration_s
+    duration = defaults_for(model).kick_duration_s
     hint = f"Peak of the half-sine force pulse on the base ({duration:g} s long), N"
     if model.m > 1:
         hint += "; along the direction chosen under Base coordinates (N m on a rotation)"

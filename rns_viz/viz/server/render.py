@@ -20,13 +20,12 @@ from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.loop.session import Session
 from rns_viz.live.operator.dual_arm import is_dual
 from rns_viz.live.published.snapshot import Snapshot
-from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.live.teaching.rank_view import has_rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
-from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
+from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_presets
 from rns_viz.viz.panels.gain_panel import GainExplorerView
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
@@ -93,7 +92,7 @@ class Renderer:
         self.model = FsmsModel.from_key(snap.settings.model)  # drawing only (its own pinocchio data)
         spatial = len(self.model.task_rows) == 3  # the handle moves in 3-D and gives (x, y, z)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
-        self._reach = arm_reach(self.model)
+        self._reach = self.model.arm_reach
         self.teach = TeachScene(self.server, self.model, self.scene)
         self.rank = RankScene(self.server, self.model, self.scene.style)
         dual = is_dual(self.model)
@@ -113,7 +112,7 @@ class Renderer:
         self.controls.target_lift = np.array([0.0, 0.0, st.overlay_z])
         if self.base_panel is not None:
             self.base_panel.for_model(self.model)
-        show_boom_presets(self.gui, snap.settings.model)
+        show_presets(self.gui.presets, self.gui.menu, snap.settings.model)
         self.gui.target_text.content = target_text(self.model)
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
@@ -141,7 +140,7 @@ class Renderer:
         self.names_drawn |= built
         g, controls = self.gui, self.controls
         with controls.quiet():
-            defaults = defaults_for(snap.settings.model)
+            defaults = defaults_for(self.model)
             g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
