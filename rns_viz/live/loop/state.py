@@ -21,7 +21,6 @@ from rns_viz.live.loop.replay_mode import apply_replay
 from rns_viz.live.loop.settle import settled_elsewhere
 from rns_viz.live.loop.shown_geometry import Geometry
 from rns_viz.live.loop.wall_clock import Pacer
-from rns_viz.live.operator.dual_arm import refuse_other_laws
 from rns_viz.live.operator.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs.step_outputs import Outputs
 from rns_viz.live.published.snapshot import Level, Notice, ReplayView, Settings, Snapshot
@@ -64,7 +63,7 @@ class LiveState:
         if self.aux is None or self.aux.name != name:
             loaded = LoopModel.load(name)
             self.aux, self.field, self.bounds = loaded.model, loaded.field, loaded.bounds
-            self.reach_m, self.tol = loaded.reach_m, loaded.tol
+            self.operator_kind, self.reach_m, self.tol = loaded.kind, loaded.reach_m, loaded.tol
 
     @property
     def model(self) -> FsmsModel:
@@ -93,7 +92,7 @@ class LiveState:
 
     def _new_operator(self, theta: np.ndarray) -> None:
         st = self.settings
-        self.operator: Operator | None = Operator(self.model, theta, st.ubar_speed, st.target_speed)
+        self.operator: Operator | None = self.operator_kind(self.model, theta, st.ubar_speed, st.target_speed)
         self._install_live_laws()
 
     def _install_live_laws(self) -> None:
@@ -145,7 +144,7 @@ class LiveState:
 
     def _request_geometry(self, theta: np.ndarray, default: bool = False) -> None:
         """The path or reachable set through ``theta``, and the gain analysis about it."""
-        self.geometry.request(self.model, self.field, self.epoch, theta, default)
+        self.geometry.request(self.operator_kind, self.model, self.field, self.epoch, theta, default)
         self._explore(theta)
 
     def _explore(self, theta: np.ndarray) -> None:
@@ -213,7 +212,7 @@ class LiveState:
                     self.explorer.forget_measurement()
                 self.settings = replace(st, suppress=on)
             case c.SetLaw(law=law):
-                refuse_other_laws(self.model, law)
+                self.operator_kind.check_law(self.model.name, law)
                 self._gain_memory[(st.model, st.law)] = st.gains
                 gains = self._gain_memory.get((st.model, law), defaults_for(self.model).gains_for(law))
                 self.settings = replace(st, law=law, gains=gains)
@@ -381,8 +380,8 @@ class LiveState:
                     if waiting is not None:
                         self.apply(waiting)
                 case ReachReady(region=region):
-                    if self.operator is not None and not self.operator.on_path:
-                        self.operator.reach = region
+                    if self.operator is not None:
+                        self.operator.take_reach(region)
                     self.geometry.took_reach(region)
                     self.explorer.along(self.model.name, region.thetas, region.points)
                     self._overlays_changed()

@@ -18,7 +18,7 @@ import viser
 from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.loop.session import Session
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.live.teaching.rank_view import has_rank_inset
@@ -95,7 +95,8 @@ class Renderer:
         self._reach = self.model.arm_reach
         self.teach = TeachScene(self.server, self.model, self.scene)
         self.rank = RankScene(self.server, self.model, self.scene.style)
-        dual = is_dual(self.model)
+        self.kind = operator_class(self.model)  # what the operator drives: the panel's folders, laws and words
+        dual = self.kind.compensates
         self.teach.reaction_label = "residual reaction" if dual else REACTION_LABEL
         self.gui.plots.sides = COMPENSATION_SIDES if dual else SUPPRESSION_SIDES
         st = self.scene.style
@@ -121,7 +122,7 @@ class Renderer:
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
         self.scene.set_target(snap.target)
-        self.explorer.build_scene(self.scene.style, self.model.n - len(self.model.selected) == 1)
+        self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
 
     def _home(self, snap: Snapshot) -> np.ndarray:
         """Where the target handle rests: the session's target, else the end effector."""
@@ -342,14 +343,14 @@ class Renderer:
         if self.base_panel is not None:
             self.base_panel.sync(snap, self.model)
         g.preset_info.content = preset_description(st.preset)
-        on_path = self.model.n - len(self.model.selected) == 1
+        on_path = self.kind.follows == "path"
         g.path_folder.visible = on_path
         g.target_folder.visible = not on_path
         task_gains = not on_path and st.law != "velocity"
         joint_gains = on_path and st.law != "velocity"
         g.gains["G_p"].visible = g.gains["G_d"].visible = task_gains
         g.gains["k_p"].visible = g.gains["k_d"].visible = joint_gains
-        g.law.disabled = is_dual(self.model)  # one law for dual arms: the compensating law
+        g.law.disabled = len(self.kind.laws) == 1  # one law for dual arms: the compensating law
 
 
 class _Seen:
