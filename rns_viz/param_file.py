@@ -235,7 +235,8 @@ def _check(spec: ParamFile) -> str | None:
         value = getattr(base, key)
         if value is not None and (len(value) != m or any(len(row) != m for row in value)):
             got = f"{len(value)} x {len(value[0])}" if len({len(r) for r in value}) == 1 else "rows of unequal length"
-            return f"[base] {key}: expected a {m} x {m} matrix, got {got} (its shape: a row and a column per base joint)"
+            shape = "its shape: a row and a column per base joint"
+            return f"[base] {key}: expected a {m} x {m} matrix, got {got} ({shape})"
     if base.selection is not None and (len(base.selection) != m or not any(base.selection)):
         return f"[base] selection: expected {m} flags of 0 or 1 with at least one 1, got {list(base.selection)}"
     n = len(spec.model.default_configuration_deg)
@@ -247,7 +248,8 @@ def _check(spec: ParamFile) -> str | None:
     arms = spec.arms
     if arms is not None:
         groups = arms.compensating
-        if not arms.task or not groups or not (all(isinstance(g, str) for g in groups) or all(map(_names, groups))):
+        lists = all(isinstance(g, tuple) and len(g) > 0 for g in groups)
+        if not arms.task or not groups or not (all(isinstance(g, str) for g in groups) or lists):
             return "[arms] task and compensating: expected a non-empty list of joint names (or of such lists)"
     app = spec.app
     if app.kick_axis is not None and app.kick_axis not in base.joints:
@@ -255,10 +257,6 @@ def _check(spec: ParamFile) -> str | None:
     if abs(app.kick_peak_N) > app.kick_range_N:
         return f"[app] kick_peak_N: {app.kick_peak_N:g} N is beyond the slider's ±{app.kick_range_N:g} N (kick_range_N)"
     return None
-
-
-def _names(group: object) -> bool:
-    return isinstance(group, tuple) and len(group) > 0
 
 
 def unknown(name: str, known: tuple[str, ...] | list[str], what: str) -> str:

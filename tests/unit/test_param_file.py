@@ -214,3 +214,13 @@ def test_the_bundled_models_are_the_files_with_an_app_table_in_menu_order(tmp_pa
     text = (tmp_path / "second.toml").read_text()
     (tmp_path / "no_app.toml").write_text(text[: text.index("\n[app]")])
     assert _bundled(tmp_path) == ("first", "second")
+
+
+@pytest.mark.parametrize(
+    "compensating",
+    ["compensating = []", 'compensating = [["c_joint1", "c_joint2"], []]', 'compensating = ["c_joint1", ["c_joint2"]]'],
+)
+def test_arms_without_joints_are_refused(tmp_path: Path, compensating: str) -> None:
+    path = copy_of(tmp_path, "trep2", edit=('compensating = ["c_joint1", "c_joint2"]', compensating))
+    expected = "[arms] task and compensating: expected a non-empty list of joint names (or of such lists)"
+    assert refusal(path) == expected
