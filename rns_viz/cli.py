@@ -15,14 +15,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rns_viz.params import MODEL_NAMES, ModelFileError, model_key
+from rns_viz.params import MODEL_NAMES, ModelFileError, model_key, param_file_for
 
 if TYPE_CHECKING:
     from rns_viz.model import FsmsModel
 
-MODEL_HELP = (
-    "trep, trep2, planar3r, boom7 (bundled), boom-panda (with rns-viz[panda]), or a model's parameter file (.toml)"
-)
+MODEL_HELP = f"{', '.join(MODEL_NAMES)} (bundled; a packaged arm needs its extra), or a model's parameter file (.toml)"
 
 
 class CliError(Exception):
@@ -222,11 +220,11 @@ def cmd_serve(args: argparse.Namespace) -> None:
         _load_model(name)
     model = models[0]
     if args.lesson is not None:
-        from rns_viz.live.teaching.lessons import LESSONS
+        from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
 
-        if model not in LESSONS:
-            raise CliError(f"{model} has no lessons; there are some for {', '.join(LESSONS)}")
-        count = len(LESSONS[model])
+        count = len(lessons_for(model))
+        if count == 0:
+            raise CliError(f"{model} has no lessons; there are some for {', '.join(models_with_lessons())}")
         if args.lesson > count:
             raise CliError(f"{model} has lessons 1 to {count}, not {args.lesson}")
     extra = [name for name in models if name.endswith(".toml")]
@@ -239,7 +237,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Reaction null-space control of a flexible-structure-mounted manipulator "
         "(Nenchev et al. 1999). Without a command, starts the browser app.",
     )
-    lesson_help = "start the app at lesson N of the model (TREP: 1-6, planar3r: 1-3, boom7: 1-3)"
+    offered = ((name, len(param_file_for(name).app.lessons)) for name in MODEL_NAMES)
+    counts = ", ".join(f"{name}: 1-{count}" for name, count in offered if count)
+    lesson_help = f"start the app at lesson N of the model ({counts})"
     parser.add_argument("--lesson", dest="top_lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
     sub = parser.add_subparsers(dest="command")
     info = sub.add_parser("info", help="print a model's dimensions and base parameters as JSON")

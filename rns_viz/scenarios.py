@@ -5,8 +5,8 @@ redundancy on trep2 (Sec. III-B: a compensating second arm).
 Each preset builds a ready :class:`Simulator` with the paper's parameters. Choices the paper
 leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS and the
 same experiments with the Franka Panda on that boom (boom-panda) in PANDA_SCENARIOS; trep2's are in
-DUAL_SCENARIOS; the live app offers all of them (LIVE_SCENARIOS);
-``run_scenario`` runs all of them.
+DUAL_SCENARIOS; the live app offers all of them (LIVE_SCENARIOS), each model those its parameter file
+names (``[app] presets``, :func:`presets_for`); ``run_scenario`` runs all of them.
 """
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.reference import path_integral_to
 from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
+from rns_viz.param_file import ModelFileError, unknown
+from rns_viz.params import param_file_for, source_path
 from rns_viz.profiles import CyclicUbar, QuinticUbar
 from rns_viz.sim import ForcePulse, Simulator
 
@@ -315,6 +317,16 @@ DUAL_SCENARIOS: dict[str, Scenario] = {
 }
 ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **PANDA_SCENARIOS, **DUAL_SCENARIOS}
 LIVE_SCENARIOS: dict[str, Scenario] = dict(ALL_SCENARIOS)  # the app's presets
+
+
+def presets_for(key: str) -> tuple[str, ...]:
+    """The presets a model offers in the app (its parameter file's ``[app] presets``); each runs as written, on
+    the model it was written for. ModelFileError (a ValueError) for a name no preset has."""
+    names = param_file_for(key).app.presets
+    for name in names:
+        if name not in LIVE_SCENARIOS:
+            raise ModelFileError(f"{source_path(key)}: [app] presets: {unknown(name, list(LIVE_SCENARIOS), 'preset')}")
+    return names
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:

@@ -70,7 +70,7 @@ def test_every_control_and_scene_node_exists(name: str) -> None:
         assert set(g.gains) == {"g_b", "g_m", "G_p", "G_d", "k_p", "k_d"}
         assert all("(" in s.label for s in g.gains.values())  # units in every gain label
         assert g.speed.options == ("1/8×", "1/4×", "1/2×", "1×", "2×")
-        assert set(g.presets_trep.options) | set(g.presets_3r.options) == PAPER_PRESETS
+        assert set(g.presets["trep"].options) | set(g.presets["planar3r"].options) == PAPER_PRESETS
         assert g.path_folder.visible == (name == "trep") and g.target_folder.visible == (name == "planar3r")
         for node in (FsmsScene.BASE, FsmsScene.FORCE, FsmsScene.TARGET, TARGET_HANDLE):
             assert app.server.scene.get_handle_by_name(node) is not None, node
@@ -231,7 +231,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         s = app.session
-        app.gui.presets_trep.value = "fig10-on"
+        app.gui.presets["trep"].value = "fig10-on"
         queued(app, "LoadPreset")
         s.advance(0.0)
         assert s.wait_background()
@@ -244,7 +244,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
         s.advance(1.0)  # the preset's kick comes at 0.5 s
         assert peak_xb(s, 1.0) > 1e-3
         app.gui.preset_paused.value = False  # this one starts at once
-        app.gui.presets_3r.value = "fig3"  # a 3R preset switches the model
+        app.gui.presets["planar3r"].value = "fig3"  # a 3R preset switches the model
         queued(app, "LoadPreset")
         s.advance(0.0)
         assert s.wait_background()

@@ -25,7 +25,7 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.commands import LIVE_LAWS
 from rns_viz.scenarios import LIVE_SCENARIOS
 from rns_viz.viz.clients.connections import BROWSER_KEY
-from rns_viz.viz.panels.lesson_panel import CHOICES
+from rns_viz.viz.panels.lesson_panel import lesson_choices
 from rns_viz.viz.scene.scene_nodes import node_names
 from rns_viz.viz.server.app import IDLE_RESTART_S, RnsApp, start_app
 from tests.support.app_helpers import Faults, user_model
@@ -243,7 +243,7 @@ class AppStates(RuleBasedStateMachine):
     @rule(
         change=st.one_of(
             st.tuples(st.just("load_preset"), st.sampled_from(sorted(LIVE_SCENARIOS)), st.booleans()),
-            st.tuples(st.just("start_lesson"), st.sampled_from(sorted(CHOICES.values()))),
+            st.tuples(st.just("start_lesson"), st.sampled_from(sorted(lesson_choices().values()))),
             st.tuples(st.just("selection"), st.sampled_from(SELECTIONS)),
             st.sampled_from((("reset",), ("stop_lesson",))),
         )

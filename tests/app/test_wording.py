@@ -19,7 +19,7 @@ import viser
 import rns_viz
 from rns_viz.live.published.snapshot import LessonStatus
 from rns_viz.live.teaching import lessons, lessons_boom
-from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
 from rns_viz.viz.panels import lesson_panel
 from rns_viz.viz.server.app import RnsApp, start_app
 
@@ -72,7 +72,8 @@ def progress_texts() -> list[str]:
 
 
 def lesson_texts() -> list[str]:
-    texts = [part for ls in LESSONS.values() for lesson in ls for part in (lesson.text, lesson.task)]
+    lessons = [lesson for model in models_with_lessons() for lesson in lessons_for(model)]
+    texts = [part for lesson in lessons for part in (lesson.text, lesson.task)]
     return [*texts, *progress_texts(), lesson_panel.NO_LESSON, lesson_panel.LAST_DONE]
 
 
@@ -90,7 +91,8 @@ def test_no_lesson_asks_for_a_disabled_control(app: RnsApp) -> None:
     snap = app.session.snapshot()
     states = [None] + [
         LessonStatus(model, k, len(ls), lesson.title, lesson.equation, lesson.text, lesson.task, done, "…")
-        for model, ls in LESSONS.items()
+        for model in models_with_lessons()
+        for ls in (lessons_for(model),)
         for k, lesson in enumerate(ls, start=1)
         for done in (False, True)
     ]
@@ -101,7 +103,7 @@ def test_no_lesson_asks_for_a_disabled_control(app: RnsApp) -> None:
             for handle in names.get(name, []):
                 if isinstance(handle, viser.GuiButtonHandle):
                     assert not handle.disabled, f"{status}: the text asks for {name!r}, which is disabled"
-    last = LESSONS["trep"][-1]
+    last = lessons_for("trep")[-1]
     done = LessonStatus("trep", 6, 6, last.title, last.equation, last.text, last.task, True, "")
     app.lessons.refresh(replace(snap, lesson=done))
     assert app.lessons.next.disabled and "*Next*" not in app.lessons.text.content

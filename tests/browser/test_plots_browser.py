@@ -19,8 +19,7 @@ import pytest
 from playwright.sync_api import Page
 
 from rns_viz.live.published.plot_buffers import PLOT_SERIES
-from rns_viz.scenarios import SCENARIOS
-from rns_viz.viz.panels.control_panel import PLANAR3R_PRESETS, TREP_PRESETS
+from rns_viz.scenarios import SCENARIOS, presets_for
 from rns_viz.viz.panels.live_plots import SCALES, LivePlots
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
@@ -122,11 +121,12 @@ def shoot(page: Page, name: str, top: str = "Operate") -> None:
 
 def test_every_preset_fills_the_plots_and_fig11_shows_the_contrast(app: RnsApp) -> None:
     s = app.session
-    assert set(TREP_PRESETS) | set(PLANAR3R_PRESETS) == set(SCENARIOS)
+    trep_presets, planar3r_presets = presets_for("trep"), presets_for("planar3r")
+    assert set(trep_presets) | set(planar3r_presets) == set(SCENARIOS)
     with browser_page(app.server, width=1400, height=900) as page:
         dismiss_notifications(page)
         peaks: dict[str, float] = {}
-        for name in ("fig3", "fig4", *TREP_PRESETS):  # fig3 first: from TREP, with a model switch
+        for name in ("fig3", "fig4", *trep_presets):  # fig3 first: from TREP, with a model switch
             run_preset(page, app, name)
             wait_until(lambda: page_peak(page, "xb-on") > 0.0, 10.0, f"the peaks of {name}")
             peaks[name] = page_peak(page, "xb-on")

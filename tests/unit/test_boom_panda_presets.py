@@ -25,10 +25,10 @@ from rns_viz.scenarios import (
     SPATIAL_SCENARIOS,
     boom7_path_reference,
     boom7_track_end,
+    presets_for,
     run_scenario,
 )
 from rns_viz.sim import Simulator
-from rns_viz.viz.panels.control_panel import BOOM7_PRESETS, PANDA_PRESETS
 from tests.support.logs import columns
 
 pytestmark = pytest.mark.skipif(
@@ -52,7 +52,8 @@ def test_the_panda_has_boom7s_five_experiments_under_its_own_name() -> None:
         s.removeprefix("boom7-") for s in SPATIAL_SCENARIOS
     ]
     assert all(s.model == "boom-panda" for s in PANDA_SCENARIOS.values())
-    assert tuple(PANDA_SCENARIOS) == PANDA_PRESETS and not set(PANDA_PRESETS) & set(BOOM7_PRESETS)
+    panda, boom7 = presets_for("boom-panda"), presets_for("boom7")
+    assert tuple(PANDA_SCENARIOS) == panda and not set(panda) & set(boom7)
 
 
 @pytest.mark.parametrize("name", list(PANDA_SCENARIOS))

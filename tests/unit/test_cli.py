@@ -95,4 +95,4 @@ def test_malformed_parameter_file(tmp_path: Path) -> None:
     bad.write_text(params.replace("stiffness = [[77.9218]]", 'stiffness = [["stiff"]]'))
     result = run("info", "--model", str(bad))
     assert result.returncode == 2 and "Traceback" not in result.stderr
-    assert "bad.toml: [base] stiffness must be numbers" in result.stderr
+    assert "bad.toml: [base] stiffness[0][0]: expected a number, got a string" in result.stderr

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rns_viz.integrability import check_integrability
-from rns_viz.live.operator.operator import InputRefused
+from rns_viz.live.operator.kinds import operator_class
+from rns_viz.live.operator.operator import InputRefused, Operator
 from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.divergence_guard import Bounds
 from rns_viz.model import FsmsModel
@@ -24,6 +25,7 @@ from rns_viz.paths import CouplingField
 @dataclass(frozen=True)
 class LoopModel:
     model: FsmsModel  # for references and readouts (the runs have their own instances)
+    kind: type[Operator]  # what the operator drives on it (a path, a reachable set, a task arm)
     field: CouplingField  # S H_bm and its potential at many configurations
     bounds: Bounds  # the divergence guard's physical bounds
     reach_m: float  # m: the arm's reach
@@ -34,7 +36,8 @@ class LoopModel:
         """Read model ``key``; raises ModelFileError (a ValueError) with the element at fault."""
         model = FsmsModel.from_key(key)
         reach = arm_reach(model)
-        return cls(model, CouplingField(model), Bounds(model), reach, 1e-4 * model.arm_mass * reach)
+        kind = operator_class(model)
+        return cls(model, kind, CouplingField(model), Bounds(model), reach, 1e-4 * model.arm_mass * reach)
 
     def copy_model(self) -> FsmsModel:
         """Another instance of the same (already checked) model, with its own pinocchio data."""

@@ -16,8 +16,6 @@ For a model with ``[arms]`` (trep2) the live session runs :class:`~rns_viz.contr
 
 from __future__ import annotations
 
-from functools import cache
-
 import numpy as np
 
 from rns_viz.control import ControlOutput, Gains, TaskSample
@@ -34,12 +32,6 @@ CANCEL_RATIO = 0.05  # a residual L above this fraction of the task arm's moment
 def is_dual(model: FsmsModel) -> bool:
     """The model has a task arm and a compensating arm (``[arms]`` of its parameter file)."""
     return "task" in model.arm_groups and "compensating" in model.arm_groups
-
-
-@cache
-def dual_by_name(key: str) -> bool:
-    """:func:`is_dual` of the model a model key names (bundled or a file, with its S)."""
-    return is_dual(FsmsModel.from_key(key))
 
 
 def dual_law(model: FsmsModel, gains: Gains, suppress: bool, task: TaskSample | None, shadow: bool) -> CompensatingLaw:
@@ -155,11 +147,3 @@ def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarra
         rate, limit = abs(float(v[joints[k]])), float(model.pin_model.velocityLimit[joints[k]])
         return f"compensator beyond its speed: {rate:.1f} rad/s > its {limit:g} rad/s limit"
     return None
-
-
-def refuse_other_laws(model: FsmsModel, law: str) -> None:
-    """A dual-arm model runs the compensating law, resolved acceleration like (15): no other law choice."""
-    if is_dual(model) and law != "acceleration":
-        raise ValueError(
-            f"{model.name} runs the compensating law (resolved acceleration, like (15)); law {law!r} is not offered"
-        )

@@ -6,7 +6,8 @@ from functools import cache
 
 import numpy as np
 
-from rns_viz.live.operator.dual_arm import compensator_sigmas, is_dual
+from rns_viz.live.operator.dual_arm import compensator_sigmas
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.published.snapshot import Readouts
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector, rns_projector, singularity_distance, truncated_inverse
@@ -16,7 +17,7 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
     """S H_bm, its distance to singularity (kg m, rns.singularity_distance), the RNS-rank-th singular value
     of J-bar and the RNS dimension
     (dual arms: the compensator's sigma_min(W S H_bm,2) and the task arm's sigma_min(J_1) instead)."""
-    if is_dual(model):
+    if operator_class(model).compensates:
         return compensator_sigmas(model, theta)
     H = model.coupling_at(theta)
     rns_dim = model.n - H.shape[0]
@@ -67,5 +68,5 @@ def compute_readouts(
         ee_error=ee_error,
         reaction=reaction,
         reaction_t=reaction_t,
-        dual=is_dual(model),
+        dual=operator_class(model).compensates,
     )

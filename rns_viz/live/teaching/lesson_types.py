@@ -96,6 +96,7 @@ class LessonStart:
 
 @dataclass(frozen=True)
 class Lesson:
+    name: str  # what a parameter file's [app] lessons calls it
     title: str
     equation: str  # the paper's equation(s) it is about
     text: str  # one or two sentences of explanation

@@ -141,6 +141,7 @@ class ForcesStayZero(Check):
 
 BOOM7_LESSONS = (
     Lesson(
+        "boom7-six-modes",
         "A kick in six directions",
         "Eqs. (13), (15)",
         "boom7: a 7-joint arm on the tip of a 4 m boom. The tip has six elastic coordinates: three "
@@ -152,6 +153,7 @@ BOOM7_LESSONS = (
         SixModesSuppressed,
     ),
     Lesson(
+        "boom7-path",
         "A reactionless path in 3-D",
         "Eqs. (9), (11): θ' = n ū",
         "With all six reactions selected (r = 6) seven joints leave a one-dimensional reaction null space: "
@@ -162,6 +164,7 @@ BOOM7_LESSONS = (
         BoomStaysStill,
     ),
     Lesson(
+        "boom7-forces-only",
         "Forces only",
         "Sec. III-B: S H_bm",
         "Select only the forces (S = x, y, z): the reaction null space grows to four dimensions, enough to "

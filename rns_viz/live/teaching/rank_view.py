@@ -16,7 +16,7 @@ from functools import cache
 
 import numpy as np
 
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.model import FsmsModel
 from rns_viz.rank import rank_deficient_configurations, sigma_grid
 
@@ -42,7 +42,7 @@ class RankOverlay:
 
 def has_rank_inset(model: FsmsModel) -> bool:
     """The model has a rank-loss overlay and inset: one arm of 2 or 3 joints."""
-    return not is_dual(model) and model.n in SEEDS_PER_JOINT
+    return not operator_class(model).compensates and model.n in SEEDS_PER_JOINT
 
 
 @cache

@@ -18,18 +18,12 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.runs.laws import LAW_LABELS
-from rns_viz.params import model_source
-from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, PANDA_SCENARIOS
+from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, presets_for
 from rns_viz.viz.panels.live_plots import LivePlots
 from rns_viz.viz.panels.model_menu import ModelMenu
 from rns_viz.viz.panels.number_field import NumberField, hide_slider_boxes
 
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
-TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
-PLANAR3R_PRESETS = ("fig3", "fig4")
-BOOM7_PRESETS = ("boom7-kick-on", "boom7-kick-off", "boom7-path", "boom7-track", "boom7-p2p")
-PANDA_PRESETS = tuple(PANDA_SCENARIOS)  # the same five on the Panda; shown instead while boom-panda is served
-DUAL_PRESETS = tuple(DUAL_SCENARIOS)  # trep2: the task arm's circle and a kick, compensator on and off
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
@@ -111,11 +105,7 @@ class GuiElements:
     target_speed: NumberField
     law: viser.GuiDropdownHandle
     gains: dict[str, NumberField]
-    presets_trep: viser.GuiButtonGroupHandle
-    presets_3r: viser.GuiButtonGroupHandle
-    presets_dual: viser.GuiButtonGroupHandle
-    presets_boom7: viser.GuiButtonGroupHandle
-    presets_panda: viser.GuiButtonGroupHandle
+    presets: dict[str, viser.GuiButtonGroupHandle]  # model key -> its presets, in the menu's order
     preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
@@ -143,6 +133,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     """Build the panel for ``model`` (its kick range and exaggeration; ``menu``: the models offered, by
     default the bundled ones); the app wires the callbacks."""
     menu = menu or ModelMenu((model,))
+    defaults = defaults_for(model)
     gui = server.gui
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
     gui.main_panel.dock_right()
@@ -162,10 +153,10 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         kick_peak = NumberField(
             gui,
             "Kick peak (N)",
-            min=-defaults_for(model).kick_range_N,
-            max=defaults_for(model).kick_range_N,
+            min=-defaults.kick_range_N,
+            max=defaults.kick_range_N,
             step=0.1,
-            initial_value=defaults_for(model).kick_peak_N,
+            initial_value=defaults.kick_peak_N,
             hint="Peak of the half-sine force pulse on the base (N); the app says more per model.",
             bounded=True,  # read at the next kick
         )
@@ -184,13 +175,13 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "Reset", icon=viser.Icon.REFRESH, hint="Back to the start (of the preset, if one is loaded)."
         )
     with gui.add_folder("Paper presets"):
-        presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=preset_hint(TREP_PRESETS))
-        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=preset_hint(PLANAR3R_PRESETS))
-        presets_dual = gui.add_button_group("TREP + compensator", DUAL_PRESETS, hint=preset_hint(DUAL_PRESETS))
-        presets_boom7 = gui.add_button_group("Boom (3-D)", BOOM7_PRESETS, hint=preset_hint(BOOM7_PRESETS))
-        presets_panda = gui.add_button_group(
-            "Panda on the boom", PANDA_PRESETS, hint=preset_hint(PANDA_PRESETS), visible=False
-        )
+        presets = {}
+        for key in menu.keys.values():  # each model's presets ([app] presets), under its heading
+            names = presets_for(key)
+            if names:
+                heading = menu.presets_heading(key)
+                presets[key] = gui.add_button_group(heading, names, hint=preset_hint(names))
+        show_presets(presets, menu, model)
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
@@ -278,9 +269,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "Model",
             menu.labels,
             initial_value=menu.label(model),
-            hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring. "
-            "TREP with a compensating arm: a second arm on the beam tip cancels the first one's reaction. The "
-            "7-DOF arm on a flexible boom: a spatial system, six base coordinates. Files: given with --model.",
+            hint="The bundled models (each labelled by its parameter file) and the files given with --model "
+            "(rns-viz serve --model FILE.toml).",
         )
         exaggeration = NumberField(
             gui,
@@ -288,7 +278,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             min=1.0,
             max=100.0,
             step=1.0,
-            initial_value=defaults_for(model).exaggeration,
+            initial_value=defaults.exaggeration,
             hint="The base deflection is drawn this many times larger than simulated.",
             bounded=True,  # only drawn
         )
@@ -332,11 +322,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         target_speed=target_speed,
         law=law,
         gains=gains,
-        presets_trep=presets_trep,
-        presets_3r=presets_3r,
-        presets_dual=presets_dual,
-        presets_boom7=presets_boom7,
-        presets_panda=presets_panda,
+        presets=presets,
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
@@ -354,10 +340,19 @@ def preset_hint(names: tuple[str, ...]) -> str:
     return f"One click loads a figure's experiment (law, gains, motion, kicks, model). {what}. {units}"
 
 
-def show_boom_presets(g: GuiElements, model_key: str) -> None:
-    """The boom's presets for the arm in view: the Panda's while boom-panda is served, else boom7's."""
-    panda = model_source(model_key) == "boom-panda"
-    g.presets_panda.visible, g.presets_boom7.visible = panda, not panda
+def show_presets(presets: dict[str, viser.GuiButtonGroupHandle], menu: ModelMenu, model_key: str) -> None:
+    """One row of presets per heading: models sharing a heading (boom7 and boom-panda: the same boom) share
+    its row, which shows the served model's presets, else those of the first such model in the menu."""
+    served = menu.source_key(model_key)
+    shown: dict[str, str] = {}  # heading -> the key whose presets it shows
+    for key in presets:
+        heading = menu.presets_heading(key)
+        if heading not in shown or key == served:
+            shown[heading] = key
+    for key, group in presets.items():
+        visible = shown[menu.presets_heading(key)] == key
+        if group.visible != visible:
+            group.visible = visible
 
 
 def preset_description(name: str | None) -> str:

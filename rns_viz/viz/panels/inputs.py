@@ -195,7 +195,7 @@ class Controls:
         for name, slider in g.gains.items():
             self._on_input(slider, lambda v, c, name=name: s.set_gains(c, **{name: float(v)}))
         self._on_input(g.preset_paused, lambda v, c: None)  # read at the next preset
-        for group in (g.presets_trep, g.presets_3r, g.presets_dual, g.presets_boom7, g.presets_panda):
+        for group in g.presets.values():
             self._on_input(group, lambda v, c: s.load_preset(v, c, bool(self.good(g.preset_paused))), button=True)
         self._on_input(g.plots.scale, lambda v, c: g.plots.show_mode(_SCALE_OF_LABEL[v]))
         self._on_input(g.model, lambda v, c: s.switch_model(g.menu.key_of(v), c))

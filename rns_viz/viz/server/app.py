@@ -64,7 +64,9 @@ class RnsApp:
         self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
         self.view = make_view_toggles(server, self.connections)
         self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
-        self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
+        self.lessons = LessonPanel(
+            server, session, self.connections, self.gui.status.order + 0.5, self.view, self.gui.menu.keys.values()
+        )
         self.renderer = Renderer(
             server, session, self.gui, self.controls, self.connections, self.view, base_panel=self.base_panel
         )

@@ -18,15 +18,14 @@ import viser
 from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.loop.session import Session
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.published.snapshot import Snapshot
-from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.live.teaching.rank_view import has_rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
-from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
+from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_presets
 from rns_viz.viz.panels.gain_panel import GainExplorerView
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
@@ -93,10 +92,11 @@ class Renderer:
         self.model = FsmsModel.from_key(snap.settings.model)  # drawing only (its own pinocchio data)
         spatial = len(self.model.task_rows) == 3  # the handle moves in 3-D and gives (x, y, z)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
-        self._reach = arm_reach(self.model)
+        self._reach = self.model.arm_reach
         self.teach = TeachScene(self.server, self.model, self.scene)
         self.rank = RankScene(self.server, self.model, self.scene.style)
-        dual = is_dual(self.model)
+        self.kind = operator_class(self.model)  # what the operator drives: the panel's folders, laws and words
+        dual = self.kind.compensates
         self.teach.reaction_label = "residual reaction" if dual else REACTION_LABEL
         self.gui.plots.sides = COMPENSATION_SIDES if dual else SUPPRESSION_SIDES
         st = self.scene.style
@@ -113,7 +113,7 @@ class Renderer:
         self.controls.target_lift = np.array([0.0, 0.0, st.overlay_z])
         if self.base_panel is not None:
             self.base_panel.for_model(self.model)
-        show_boom_presets(self.gui, snap.settings.model)
+        show_presets(self.gui.presets, self.gui.menu, snap.settings.model)
         self.gui.target_text.content = target_text(self.model)
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
@@ -122,7 +122,7 @@ class Renderer:
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
         self.scene.set_target(snap.target)
-        self.explorer.build_scene(self.scene.style, self.model.n - len(self.model.selected) == 1)
+        self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
 
     def _home(self, snap: Snapshot) -> np.ndarray:
         """Where the target handle rests: the session's target, else the end effector."""
@@ -141,7 +141,7 @@ class Renderer:
         self.names_drawn |= built
         g, controls = self.gui, self.controls
         with controls.quiet():
-            defaults = defaults_for(snap.settings.model)
+            defaults = defaults_for(self.model)
             g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
@@ -343,14 +343,14 @@ class Renderer:
         if self.base_panel is not None:
             self.base_panel.sync(snap, self.model)
         g.preset_info.content = preset_description(st.preset)
-        on_path = self.model.n - len(self.model.selected) == 1
+        on_path = self.kind.follows == "path"
         g.path_folder.visible = on_path
         g.target_folder.visible = not on_path
         task_gains = not on_path and st.law != "velocity"
         joint_gains = on_path and st.law != "velocity"
         g.gains["G_p"].visible = g.gains["G_d"].visible = task_gains
         g.gains["k_p"].visible = g.gains["k_d"].visible = joint_gains
-        g.law.disabled = is_dual(self.model)  # one law for dual arms: the compensating law
+        g.law.disabled = len(self.kind.laws) == 1  # one law for dual arms: the compensating law
 
 
 class _Seen:
