@@ -1,4 +1,4 @@
-"""Model parameter files: one TOML file per model, beside its URDF in ``assets/``.
+"""Model parameter files: one TOML file per model, beside its URDF (the bundled ones in ``rns_viz/assets``).
 
 The URDF holds geometry and mass (the single source for dynamics and drawing); the parameter
 file holds what a URDF cannot say: which joints are the elastic base coordinates x_b, their
@@ -14,6 +14,7 @@ N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends i
 
 from __future__ import annotations
 
+import importlib.resources
 import math
 import tomllib
 import xml.etree.ElementTree as ET
@@ -25,9 +26,20 @@ import numpy as np
 
 from rns_viz.robots import RobotPackageMissing, composed_urdf, is_installed, packaged_arm
 
-ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
+
+def _package_data(folder: str) -> Path:
+    """A folder of rns_viz's package data, found through :mod:`importlib.resources` wherever the
+    package is installed. Pinocchio and the parameter files' relative URDF names need real files, so
+    a package imported from a zip archive is refused with that reason."""
+    path = importlib.resources.files("rns_viz") / folder
+    if not isinstance(path, Path):
+        raise ImportError(f"rns_viz's {folder} are not files on disk ({path}); install rns_viz unzipped")
+    return path
+
+
+ASSETS_DIR = _package_data("assets")  # the bundled URDFs and parameter files
 MODEL_NAMES = ("trep", "planar3r", "boom7", "trep2", "boom-panda")  # the bundled models the live app serves
-BUNDLED_MODELS = MODEL_NAMES  # every model in assets/, for FsmsModel.from_name
+BUNDLED_MODELS = MODEL_NAMES  # every model in ASSETS_DIR, for FsmsModel.from_name
 # Bundled models whose arm comes from an optional package: name -> the packaged arm (rns_viz.robots).
 PACKAGED_MODELS = {"boom-panda": "example-robot-data/panda"}
 SELECTION_MARK = "#S="  # a model key's selection suffix: "boom7#S=111000"
