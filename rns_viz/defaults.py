@@ -6,8 +6,8 @@ first. Units: gains as in :class:`~rns_viz.control.Gains`, forces N, durations s
 Why these gains. Law (30), TREP: g_b = 24, g_m = 20 as in Fig. 10. Laws (15)/(16): with the joints'
 motion outside the RNS damped by G_m and the base by g_b, the base closed loop (1-DOF base, stiffness
 k, no structural damping) has the characteristic polynomial
-    H_b s^3 + H_b (G_m + g_b) s^2 + k s + k G_m,
-whose slowest root decays fastest near g_b = 10, G_m = 2 for TREP (about 4 /s). The 3R would decay
+``H_b s^3 + H_b (G_m + g_b) s^2 + k s + k G_m``, whose slowest root decays fastest near g_b = 10,
+G_m = 2 for TREP (about 4 /s). The 3R would decay
 fastest near g_b = 2.5, G_m = 0.4 (0.92 /s), but absorbing a 5 N kick then shifts the arm's
 centre of mass so far (by about H_b g_b x_b / G_m) that the arm, holding its end effector, runs into a
 singularity of J-bar = J P_RNS; G_m = 1 (Fig. 3's value) decays at 0.37 /s and keeps the end effector
