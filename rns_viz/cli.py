@@ -263,7 +263,7 @@ def build_parser() -> argparse.ArgumentParser:
     gains = sub.add_parser("gains", help="map the closed loop's base and arm decay rates over g_b x g_m as CSV")
     gains.add_argument("--model", type=_model_arg, default="trep", help=MODEL_HELP)
     gains.add_argument("--law", type=_law_arg, default="velocity", help="15, 16, 30 or acceleration, torque, velocity")
-    gains.add_argument("--csv", required=True, help="output file (gains and rates in 1/s, see README)")
+    gains.add_argument("--csv", required=True, help="output file (gains and rates in 1/s; see the CSV formats docs)")
     gains.add_argument("--size", type=_positive_int, default=60, help="grid points per axis (default 60)")
     gains.add_argument(
         "--theta-deg", type=float, nargs="+", default=None, help="the rest configuration, deg (default: the model's)"

@@ -5,7 +5,7 @@ the keys); a file without one gets AppTable's defaults and FALLBACK_GAINS. The p
 (rns_viz.scenarios) use the paper's gains; these are what the live app offers first. Units: gains as
 in :class:`~rns_viz.control.Gains`, forces N, durations s.
 
-Why the bundled models' numbers: in the comments of their ``[app]`` tables (``assets/*.toml``).
+Why the bundled models' numbers: in the comments of their ``[app]`` tables (``rns_viz/assets/*.toml``).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Model parameter files: one TOML file per model, beside its URDF in ``assets/``.
+"""Model parameter files: one TOML file per model, beside its URDF (the bundled ones in ``rns_viz/assets``).
 
 The URDF holds geometry and mass (the single source for dynamics and drawing); the parameter
 file holds what a URDF cannot say: which joints are the elastic base coordinates x_b, their
@@ -17,6 +17,7 @@ N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends i
 
 from __future__ import annotations
 
+import importlib.resources
 import math
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -29,7 +30,18 @@ import numpy as np
 from rns_viz.param_file import AppTable, ArmsTable, ModelFileError, ParamFile, own_tables, read_param_file
 from rns_viz.robots import RobotPackageMissing, composed_urdf, is_installed, packaged_arm
 
-ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
+
+def _package_data(folder: str) -> Path:
+    """A folder of rns_viz's package data, found through :mod:`importlib.resources` wherever the
+    package is installed. Pinocchio and the parameter files' relative URDF names need real files, so
+    a package imported from a zip archive is refused with that reason."""
+    path = importlib.resources.files("rns_viz") / folder
+    if not isinstance(path, Path):
+        raise ImportError(f"rns_viz's {folder} are not files on disk ({path}); install rns_viz unzipped")
+    return path
+
+
+ASSETS_DIR = _package_data("assets")  # the bundled URDFs and parameter files
 SELECTION_MARK = "#S="  # a model key's selection suffix: "boom7#S=111000"
 
 

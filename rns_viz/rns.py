@@ -170,7 +170,7 @@ def damped_row_pinv(
     a: list[float], threshold: float = DEFAULT_THRESHOLD, max_damping: float = DEFAULT_MAX_DAMPING
 ) -> DampedInverse:
     """:func:`damped_pinv` of the one-row matrix [a] given as Python floats (a 1-DOF base, per step):
-    the column a / (|a|^2 + lambda^2), sigma = |a|. No SVD, no numpy call."""
+    the column ``a / (|a|^2 + lambda^2)``, ``sigma = |a|``. No SVD, no numpy call."""
     sigma2 = sum(map(operator.mul, a, a))
     sigma = math.sqrt(sigma2)
     lam2 = _damping_squared(sigma, threshold, max_damping)

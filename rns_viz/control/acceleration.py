@@ -39,7 +39,7 @@ def base_rows_demand(cp: Coupling, g_b: float, g_m: float, *, in_floats: bool = 
     so that d(S L)/dt = S H_bm' theta' + S H_bm theta'' = g_b S H_b x_b' - g_m S L, and with Eq. (1)'s base
     rows S [H_b (x_b'' + G_b x_b') + D_b x_b' + K_b x_b] = 0 (Eq. 13). S H_b x_b' (:attr:`Coupling.base_momentum`)
     takes every base velocity: S H_b S^T S x_b' would drop what the free coordinates' motion couples into the
-    selected rows (see README, forces-only suppression). An (r,) array; ``in_floats`` with a 1-DOF base's
+    selected rows (documentation: models, boom7 in the app). An (r,) array; ``in_floats`` with a 1-DOF base's
     row in Python floats at hand (``cp.row``, per step): y as one float from them.
     """
     row = cp.row

@@ -68,8 +68,8 @@ def trace_paths(
     along H_bm back onto the seed's level (a projection method, Hairer et al., Geometric
     Numerical Integration IV.4), which keeps the invariant to rounding instead of letting it
     drift. Other bases take plain RK4 steps.
-    ``singular_norm`` (units of |n|) stops a curve near rank loss of H_bm; by default it is
-    1e-2 of the largest |n| seen at the seeds.
+    ``singular_norm`` (units of ``|n|``) stops a curve near rank loss of H_bm; by default it is
+    1e-2 of the largest ``|n|`` seen at the seeds.
     """
     if not (np.isfinite(ds) and ds > 0):
         raise ValueError(f"ds must be a positive step in rad, got {ds}")

@@ -20,7 +20,7 @@ RowCompleter = Callable[[np.ndarray], None]  # fills derived columns of a block 
 
 
 def log_columns(m: int, n: int, r: int, p: int) -> list[str]:
-    """Column names, SI units and radians (see README, "CSV columns")."""
+    """Column names, SI units and radians (documentation: CSV formats)."""
 
     def seq(prefix: str, k: int) -> list[str]:
         return [f"{prefix}_{i + 1}" for i in range(k)]
@@ -69,7 +69,7 @@ def arm_units(model: FsmsModel) -> list[CoordinateUnits]:
 
 
 def log_units(model: FsmsModel) -> list[str]:
-    """The unit of each column of :func:`log_columns` for ``model`` (README, "CSV columns"): L_i, a row of
+    """The unit of each column of :func:`log_columns` for ``model`` (documentation: CSV formats): L_i, a row of
     S H_bm theta', is a linear or an angular momentum as its base row is a translation or a rotation."""
     base, arm = base_units(model), arm_units(model)
     return [

@@ -116,7 +116,7 @@ def shown_strings() -> Iterator[tuple[str, str]]:
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Constant) and isinstance(node.value, str):
                 yield f"{path.name}:{node.lineno}", node.value
-    for path in (ROOT.parent / "README.md", *sorted((ROOT.parent / "docs").glob("*.md"))):
+    for path in (ROOT.parent / "README.md", *sorted((ROOT.parent / "docs").rglob("*.md"))):
         yield path.name, path.read_text()
 
 

@@ -84,7 +84,7 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
     with browser_page(app.server, width=1400, height=900) as page:
         wait_for_nodes(page, {FsmsScene.BASE, TARGET_HANDLE, "/boom/tube"}, timeout=60.0)
         dismiss_notifications(page)
-        s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (README)
+        s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (docs/models.md)
         s.set_selection((True, True, True, False, False, False))  # what ticking off rx, ry, rz sends
         wait_until(lambda: s.snapshot().settings.model == "boom7#S=111000", 20.0, "the forces-only selection")
         s.track_orientation(False)  # a position handle: a pose handle's arrows turn with the hand's orientation

@@ -23,7 +23,7 @@ def _reference_coupling(s: Session) -> float:
 
 def test_live_reach_set_inside_tracked_outside_held_and_said(boom7_session: Session) -> None:
     s = boom7_session
-    s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (see README)
+    s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (docs/models.md)
     s.set_selection(FORCES)
     s.advance(0.01)
     assert s.wait_background(60.0)

@@ -143,7 +143,7 @@ def test_forces_only_tracking_is_reactionless_in_force(boom7: FsmsModel, suppres
     coupling momentum (a third of the quintic's in z).
 
     The tip's translations move either way: the moments are left free, and a moment M at a cantilever's
-    tip deflects it by M L^2/(2 EI) (README, "Modelling choices"); see the next test for a boom tip
+    tip deflects it by M L^2/(2 EI) (docs/modelling.md); see the next test for a boom tip
     that cannot turn, where forces-only tracking leaves the selected deflections at rest too.
     """
     track = boom7_track()

@@ -37,7 +37,7 @@ from rns_viz.live.published.snapshot import Notice, Overlays, Snapshot
 from rns_viz.params import check_model_key
 from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S
 
-PUBLISH_EVERY = 8  # steps between snapshots (125 Hz: two or more per 60 Hz frame; a snapshot costs ~30 us)
+PUBLISH_EVERY = 8  # steps between snapshots (125 Hz: two or more per 60 Hz frame)
 BURST_S = 0.003  # wall s: when ahead, the loop sleeps until this much simulation is due (commands wake it)
 
 

@@ -4,7 +4,7 @@
 :class:`~rns_viz.live.outputs.step_outputs.Outputs`) and keeps the newest :data:`MAX_RECORD_S` seconds in one
 preallocated ring buffer, one row per step (the columns of a
 :class:`~rns_viz.live.published.recording.Recording`). Always on because it costs
-one row copy per step (about 2 µs: 0.2 % of one core) and 60 s of TREP fill 15 MB (3R: 18 MB);
+one row copy per step, and 60 s of TREP fill 15 MB (3R: 18 MB);
 it restarts with the run (reset, model switch, preset load), so a recording never spans two systems.
 :meth:`Recorder.take` copies the newest N seconds into an immutable recording.
 """

@@ -58,7 +58,7 @@ def rank_overlay(key: str) -> RankOverlay | None:
 
 
 INSET_SLICE_STEP = np.deg2rad(5.0)  # rad: the 3R's slice follows theta_1 in steps of this
-INSET_POINTS = {2: 61, 3: 41}  # grid nodes per axis of the sigma_min field (one-off ~50 ms, a slice ~6 ms)
+INSET_POINTS = {2: 61, 3: 41}  # grid nodes per axis of the sigma_min field (the 3R's is recomputed per slice)
 
 
 @dataclass(frozen=True)

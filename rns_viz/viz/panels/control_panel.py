@@ -297,7 +297,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     download = gui.add_button(
         "Download log (CSV)",
         icon=viser.Icon.DOWNLOAD,
-        hint="The last 20 s of the simulation, one row per 1 ms step, SI units (see README).",
+        hint="The last 20 s of the simulation, one row per 1 ms step, SI units (the documentation lists the columns).",
     )
     return GuiElements(
         status=status,

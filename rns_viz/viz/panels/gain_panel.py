@@ -1,4 +1,4 @@
-"""The gain explorer in the app (issue 10): panel folder, root loci, and the map in the scene.
+"""The gain explorer in the app: panel folder, root loci, and the map in the scene.
 
 :class:`GainExplorerView` is built once with the panel; the renderer hands it each model's scene
 (:meth:`build_scene`) and calls :meth:`frame` every frame, which redraws only when

@@ -1,4 +1,4 @@
-"""The gain map and the authority colours in the 3-D scene (issue 10), so a click applies gains.
+"""The gain map and the authority colours in the 3-D scene, so a click applies gains.
 
 The map is an image standing beside the robot, facing the model's initial camera: g_b (1/s, log)
 to the right, g_m (1/s, log) upwards, each grid cell coloured by a decay rate (1/s, log colour

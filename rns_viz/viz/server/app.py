@@ -190,9 +190,8 @@ def start_app(
         session.stop()
         server.stop()
         raise
-    # The long-lived objects built so far (models, meshes, scene, GUI) leave the collector's reach:
-    # a full collection then holds the interpreter lock, and so the simulation, ~4x shorter (measured
-    # 167 -> 42 ms with 8 clients connecting and leaving).
+    # The long-lived objects built so far (models, meshes, scene, GUI) leave the collector's reach, so
+    # a full collection holds the interpreter lock, and with it the simulation, for far less time.
     gc.collect()
     gc.freeze()
     return app
