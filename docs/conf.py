@@ -6,7 +6,7 @@ import importlib.metadata
 
 project = "rns_viz"
 author = "rns_viz contributors"
-copyright = "2026, rns_viz contributors"  # noqa: A001 (Sphinx's name)
+copyright = "2026, rns_viz contributors"
 release = importlib.metadata.version("rns_viz")
 
 extensions = [
