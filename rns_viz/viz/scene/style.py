@@ -101,7 +101,8 @@ def style_for(model: FsmsModel) -> SceneStyle:
         if model.name == "trep":
             return trep
         # trep2: TREP's beam and arm; its compensating arm hangs 0.09 m below the arm plane
-        return replace(trep, grid_z=-0.17, camera_position=(0.24, 0.84, 0.1), camera_look_at=(0.0, 0.42, -0.07))
+        # seen from above the beam's tip, so neither arm hides behind it
+        return replace(trep, grid_z=-0.17, camera_position=(0.3, 0.62, 0.45), camera_look_at=(0.0, 0.42, -0.07))
     if model.name == "planar3r":
         return SceneStyle(
             base=CartSpringStyle(),

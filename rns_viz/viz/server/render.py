@@ -106,7 +106,7 @@ class Renderer:
             active_axes=(True, True, spatial),
             disable_rotations=True,
             depth_test=False,
-            position=self._home(snap) + np.array([0.0, 0.0, st.overlay_z]),
+            position=self.home(snap) + np.array([0.0, 0.0, st.overlay_z]),
         )
         self.handle.on_update(self.controls.on_drag)
         self.controls.spatial_target = spatial
@@ -124,7 +124,7 @@ class Renderer:
         self.scene.set_target(snap.target)
         self.explorer.build_scene(self.scene.style, self.model.n - len(self.model.selected) == 1)
 
-    def _home(self, snap: Snapshot) -> np.ndarray:
+    def home(self, snap: Snapshot) -> np.ndarray:
         """Where the target handle rests: the session's target, else the end effector."""
         if snap.target is not None:
             return np.asarray(snap.target, dtype=float)
@@ -224,7 +224,7 @@ class Renderer:
         pose = snap.orientation is not None and snap.orientation.on  # a pose handle: rotation rings too
         if snap.target_version != seen.target_version or pose != seen.pose:
             seen.target_version, seen.pose = snap.target_version, pose
-            home = self._home(snap)
+            home = self.home(snap)
             if np.all(np.isfinite(home)):
                 self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
             self.handle.disable_rotations, self.controls.pose_target = not pose, pose
@@ -305,7 +305,7 @@ class Renderer:
         """While a preset runs its own motion (no target) the handle stays on the end effector."""
         if snap.settings.preset is None or snap.target is not None or not np.all(np.isfinite(snap.q)):
             return
-        home = self._home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
+        home = self.home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
         if np.linalg.norm(home - np.asarray(self.handle.position)) > 0.5 * self.scene.style.marker_radius:
             self.handle.position = home
 
