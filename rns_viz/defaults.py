@@ -48,6 +48,9 @@ class ModelDefaults:
     kick_range_N: float = 5.0  # the kick slider's half range
     exaggeration: float = 10.0  # drawn deflection factor
     target_speed_m_s: float = 0.5  # speed limit of the smoothed end-effector target
+    # what the scene shows at first (names of rns_viz.viz.scene.view_toggles.TOGGLES): only what a first
+    # look needs; the rest is a tick away in *Show in the scene*, and lessons choose their own
+    shown: frozenset[str] = frozenset({"ghost", "reaction", "trail", "labels"})
 
     def gains_for(self, law: LawKind) -> Gains:
         return self.gains.get(law, FALLBACK_GAINS)
@@ -71,6 +74,7 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         kick_duration_s=0.1,
         kick_range_N=5.0,
         exaggeration=10.0,
+        shown=frozenset({"ghost", "reaction", "trail", "labels", "path_arrows"}),  # the red path and its way
     ),
     "planar3r": ModelDefaults(
         law="acceleration",
@@ -83,6 +87,7 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         kick_duration_s=0.2,
         kick_range_N=50.0,
         exaggeration=20.0,
+        shown=frozenset({"ghost", "reaction", "trail", "labels", "reach"}),  # Figs. 3, 4: the region is the point
     ),
     "boom7": ModelDefaults(
         law="acceleration",

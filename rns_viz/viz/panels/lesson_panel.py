@@ -28,7 +28,7 @@ CHOICES: dict[str, tuple[str, int]] = {
 }
 # What each lesson draws (the rest can be ticked by hand): only what the lesson has explained so far,
 # so lesson 1 shows no ghost (its suppression is lesson 4's subject) and no n (lesson 3's).
-BASICS = ("reaction", "trail")
+BASICS = ("reaction", "trail", "labels")
 LESSON_VIEWS: dict[tuple[str, int], tuple[str, ...]] = {
     ("trep", 1): BASICS,
     ("trep", 2): (*BASICS, "coupling"),

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import viser
 
+from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.session import Session
 from rns_viz.live.operator.operator_lock import OperatorLock
 from rns_viz.live.reach.region import arm_reach
@@ -65,7 +66,7 @@ class RnsApp:
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
         self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
-        self.view = make_view_toggles(server, self.connections)
+        self.view = make_view_toggles(server.gui, self.connections, defaults_for(model).shown)
         self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
         self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
         self.renderer = Renderer(
