@@ -42,6 +42,9 @@ from rns_viz.viz.scene.view_toggles import make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
 from rns_viz.viz.server.render import TARGET_HANDLE, Renderer
 
+# Served only to this machine, the first page to connect is the presenter's and operates at once; served to
+# the network (e.g. --host 0.0.0.0), a phone that connects first must not: the seat waits for Take control.
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 IDLE_RESTART_S = 60.0  # s of simulated time: a session nobody watched this long restarts for its first visitor
 
 
@@ -55,13 +58,15 @@ class RnsApp:
         password: str | None = None,
         models: Sequence[str] = (),
         pace: bool = True,
+        seat_on_connect: bool = True,
     ) -> None:
-        """``models``: parameter files offered in the model dropdown besides the bundled models;
+        """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
+        presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files offered in the model dropdown besides the bundled models;
         ``pace=False``: every page gets every update however slowly it draws."""
         self.server = server
         self.session = session
         self.password = password
-        self.connections = Connections(server, password)
+        self.connections = Connections(server, password, seat_on_connect)
         model = session.snapshot().settings.model
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
@@ -207,7 +212,7 @@ def start_app(
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password, models, pace=pace).start()
+        app = RnsApp(server, session, password, models, pace=pace, seat_on_connect=host in LOOPBACK_HOSTS).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:
