@@ -10,8 +10,8 @@ import pytest
 from rns_viz.defaults import MODEL_DEFAULTS
 from rns_viz.live.reach.region import arm_reach
 from rns_viz.viz.panels.keys import KEYS, jog_step
-from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.framing import frame_points
+from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.view_toggles import TOGGLES
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.app_helpers import stepped_app
@@ -110,25 +110,29 @@ def test_first_look_table_names_only_real_toggles_and_starts_calm() -> None:
 @pytest.mark.parametrize("model", ["trep", "boom7"])
 def test_the_app_starts_with_its_models_row_and_toggles_hide_and_show_nodes(model: str) -> None:
     for app in stepped_app(model):
-        view, server = app.view, app.server
-        assert {n for n, box in view.boxes.items() if box.value} == MODEL_DEFAULTS[model].shown
-        label = server.scene.get_handle_by_name("/base/label")
-        assert label is not None
-        settle(app)
-        wait_until(lambda: label.visible, 5.0, "the base label shown")
-        view.show("labels", False)
-        wait_until(lambda: not label.visible, 5.0, "the label hidden by its toggle")
-        view.show("labels", True)
-        wait_until(lambda: label.visible, 5.0, "the label shown again")
-        # the gain map: out of the scene until ticked
-        explorer = app.renderer.explorer
-        wait_until(lambda: explorer.scene is not None and explorer.scene.gain_map is not None, 60.0, "the map")
-        assert explorer.scene is not None
-        assert not explorer.scene.frame.visible
-        view.show("gain_map")
-        wait_until(lambda: explorer.scene.frame.visible, 5.0, "the map shown by its toggle")
-        view.show("gain_map", False)
-        wait_until(lambda: not explorer.scene.frame.visible, 5.0, "the map hidden again")
+        check_first_look_and_toggles(app, model)
+
+
+def check_first_look_and_toggles(app: RnsApp, model: str) -> None:
+    view, server = app.view, app.server
+    assert {n for n, box in view.boxes.items() if box.value} == MODEL_DEFAULTS[model].shown
+    label = server.scene.get_handle_by_name("/base/label")
+    assert label is not None
+    settle(app)
+    wait_until(lambda: label.visible, 5.0, "the base label shown")
+    view.show("labels", False)
+    wait_until(lambda: not label.visible, 5.0, "the label hidden by its toggle")
+    view.show("labels", True)
+    wait_until(lambda: label.visible, 5.0, "the label shown again")
+    # the gain map: out of the scene until ticked
+    explorer = app.renderer.explorer
+    wait_until(lambda: explorer.scene is not None and explorer.scene.gain_map is not None, 60.0, "the map")
+    assert explorer.scene is not None
+    assert not explorer.scene.frame.visible
+    view.show("gain_map")
+    wait_until(lambda: explorer.scene.frame.visible, 5.0, "the map shown by its toggle")
+    view.show("gain_map", False)
+    wait_until(lambda: not explorer.scene.frame.visible, 5.0, "the map hidden again")
 
 
 def test_other_paths_toggle_draws_the_family_or_only_the_current_path(trep_app: RnsApp) -> None:

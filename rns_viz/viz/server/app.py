@@ -61,7 +61,8 @@ class RnsApp:
         seat_on_connect: bool = True,
     ) -> None:
         """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
-        presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files offered in the model dropdown besides the bundled models;
+        presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files
+        offered in the model dropdown besides the bundled models;
         ``pace=False``: every page gets every update however slowly it draws."""
         self.server = server
         self.session = session
