@@ -28,6 +28,9 @@ class ModelDefaults:
     kick_axis: int  # the base coordinate a kick pushes along first (the panel's choice)
     exaggeration: float  # drawn deflection factor
     target_speed_m_s: float  # speed limit of the smoothed end-effector target
+    # what the scene shows at first (rns_viz.param_file.Overlay): only what a first look needs; the rest is a
+    # tick away in *Show in the scene*, and lessons choose their own
+    shown: frozenset[str]
 
     def gains_for(self, law: LawKind) -> Gains:
         return self.gains.get(law, FALLBACK_GAINS)
@@ -64,6 +67,7 @@ def defaults_from(app: AppTable, base_joints: tuple[str, ...], where: str) -> Mo
         kick_axis=0 if app.kick_axis is None else base_joints.index(app.kick_axis),
         exaggeration=app.scene.exaggeration,
         target_speed_m_s=app.target_speed_m_per_s,
+        shown=frozenset(app.scene.shown),
     )
 
 

@@ -29,6 +29,7 @@ def drawn(app: RnsApp) -> bool:
 
 def ready_app(model: str) -> Iterator[RnsApp]:
     app = start_app(model, port=0, realtime=False, verbose=False)
+    app.view.show("gain_map")  # out of the scene by default
     assert app.session.wait_background()
 
     def step() -> bool:
@@ -254,6 +255,7 @@ def test_after_a_kick_the_panel_sets_the_measured_decay_beside_the_prediction(ap
 
 def test_after_a_model_switch_the_new_models_map_is_drawn() -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False)
+    app.view.show("gain_map")  # ticked: it stays ticked across the switch (render.KEPT_ACROSS_MODELS)
     try:
         assert app.session.wait_background()
         app.session.switch_model("planar3r", None)

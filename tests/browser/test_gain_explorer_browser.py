@@ -131,6 +131,7 @@ PICTURE_WAIT_S = 20.0  # s: for the page to draw a new map's picture
 @pytest.fixture(params=["trep", "planar3r", "boom7"], name="map_app")
 def each_model_map_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
     app = start_app(request.param, port=0, verbose=False)
+    app.view.show("gain_map")  # out of the scene by default
     yield app
     app.stop()
 

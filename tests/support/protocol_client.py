@@ -156,6 +156,10 @@ class ProtocolClient:
         """A slider, checkbox, text field or dropdown changed."""
         self.gui_update(uuid, value=value)
 
+    def command(self, uuid: str) -> None:
+        """A keyboard command (its hotkey pressed, or picked in the command palette)."""
+        self._send(_messages.CommandTriggerMessage(uuid))
+
     def click(self, uuid: str, value: Any = True) -> None:
         """A button click (a button group sends the clicked option as the value)."""
         self.gui_update(uuid, value=value)

@@ -78,6 +78,11 @@ def refusal(path: Path) -> str:
             "[app.scene.base] kind: 'double-beams' is not allowed (did you mean double-beam?)",
         ),
         ("boom7", ('kick_axis = "base_y"', 'kick_axis = "base_yy"'), "[app] kick_axis: unknown base joint 'base_yy'"),
+        (
+            "trep",
+            ('"path_arrows"]', '"path_arows"]'),
+            "[app.scene] shown[4]: 'path_arows' is not allowed (did you mean path_arrows?)",
+        ),
     ],
 )
 def test_a_misspelt_key_or_name_is_refused_with_its_table_and_the_nearest_known_one(
@@ -170,7 +175,7 @@ def test_a_file_without_app_gets_generic_defaults(tmp_path: Path) -> None:
 
 def test_every_scene_key_reaches_the_drawing(tmp_path: Path) -> None:
     """Each [app.scene] length is drawn as written (its unit suffix dropped), none is ignored."""
-    keys = [k for k in SceneTable.__struct_fields__ if k not in ("exaggeration", "base")]
+    keys = [k for k in SceneTable.__struct_fields__ if k not in ("exaggeration", "base", "shown")]  # shown: test_stage
     values = {
         k: f"[{i + 1}.0, {i + 2}.0, {i + 3}.0]"
         if k.endswith(("position_m", "at_m", "origin_m", "label_m"))

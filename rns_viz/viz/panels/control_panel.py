@@ -19,10 +19,12 @@ from rns_viz.live.loop.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, presets_for
+from rns_viz.viz.panels.glossary import glossary_markdown
 from rns_viz.viz.panels.live_plots import LivePlots
 from rns_viz.viz.panels.model_menu import ModelMenu
 from rns_viz.viz.panels.number_field import NumberField, hide_slider_boxes
 
+PLOTS_WIDTH_PX = 360  # the docked plots' width: a 1366 px screen keeps ~600 px of scene between the panels
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
@@ -84,6 +86,7 @@ class GuiElements:
     """Handles of everything in the panel (the app reads and wires them; tests find them here)."""
 
     status: viser.GuiHtmlHandle
+    frame_robot: viser.GuiButtonHandle
     kick: viser.GuiButtonHandle
     kick_peak: NumberField
     suppression: viser.GuiCheckboxHandle
@@ -93,6 +96,7 @@ class GuiElements:
     speed: viser.GuiDropdownHandle
     readouts: viser.GuiHtmlHandle
     plots: LivePlots
+    plots_panel: viser.PanelHandle
     path_folder: viser.GuiFolderHandle
     sigma: NumberField
     play_slow: viser.GuiButtonHandle
@@ -138,7 +142,21 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
     gui.main_panel.dock_right()
     hide_slider_boxes(gui)  # every slider's value is shown and typed in its NumberField's box
+    # The live plots in their own panel, docked left of the scene: in view beside the robot whatever the
+    # main panel is scrolled to (on a phone: a section of viser's bottom sheet, collapsed at first).
+    plots_panel = gui.add_panel(order=0.0)
+    with plots_panel.add_tab("Live plots (last 10 s)", viser.Icon.CHART_LINE):
+        plots = LivePlots(gui)
+    with plots_panel.add_tab("Help: words and keys", viser.Icon.HELP):
+        gui.add_markdown(glossary_markdown())
+    plots_panel.dock_left()
+    plots_panel.set_width(PLOTS_WIDTH_PX)
     status = gui.add_html("")
+    frame_robot = gui.add_button(
+        "Frame robot",
+        icon=viser.Icon.FOCUS_CENTERED,
+        hint="Your camera back on the robot, framed for your screen (key F). Moves only your own view.",
+    )
     gui.add_markdown(
         "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
         "drag the handle labelled **drag me** in the scene (its arrows or its square)."
@@ -188,8 +206,6 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="A preset waits at t = 0 for Resume, so its kick and motion happen with the plots in view.",
         )
         preset_info = gui.add_markdown("")
-    with gui.add_folder("Live plots (last 10 s)"):
-        plots = LivePlots(gui)
     with gui.add_folder("Readouts"):
         readouts = gui.add_html("")
     with gui.add_folder("Reactionless path") as path_folder:
@@ -301,6 +317,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     )
     return GuiElements(
         status=status,
+        frame_robot=frame_robot,
         kick=kick,
         kick_peak=kick_peak,
         suppression=suppression,
@@ -310,6 +327,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         speed=speed,
         readouts=readouts,
         plots=plots,
+        plots_panel=plots_panel,
         path_folder=path_folder,
         sigma=sigma,
         play_slow=play_slow,

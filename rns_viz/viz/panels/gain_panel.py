@@ -88,7 +88,8 @@ class GainExplorerView:
         g = server.gui
         with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
             g.add_markdown(
-                "**Gain map** in the scene (left of the robot): each cell is a (g_b, g_m) setting, coloured by "
+                "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
+                "(g_b, g_m) setting, coloured by "
                 "how fast the closed loop, linearised about the current pose, damps the chosen mode. "
                 "**Click a cell** to apply its gains."
             )
@@ -117,6 +118,11 @@ class GainExplorerView:
         self._drawn: dict[str, object] = {}
         self._loci_of: tuple[str, str] | None = None  # (model, law) of the root loci drawn
         self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
+
+    def show(self, on: bool) -> None:
+        """Show or hide the map and the authority overlay in the scene (the *Gain map* toggle)."""
+        if self.scene is not None and self.scene.set_shown(on) and on:
+            self._version, self._drawn, self._next_check = -1, {}, 0.0  # draw the view now
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:
         """The model's scene was (re)built: add the map to it."""

@@ -58,6 +58,7 @@ class Controls:
         self.spatial_target = False  # the handle gives (x, y, z), not (x, y): set by the renderer per model
         self.target_lift = np.zeros(3)  # m: the handle is drawn this far above the target (base frame)
         self.pose_target = False  # the handle's orientation is the target's too (set by the renderer)
+        self._button_acts: dict[int, Act] = {}  # id(button) -> what a click does (a key press does the same)
         self._wire()
 
     # ---------------------------------------------------------------- values shown vs. values in force
@@ -118,6 +119,7 @@ class Controls:
             self._apply(handle, event.client, event.target.value, act, check=checked, keep=not button)
 
         if button:
+            self._button_acts[id(handle)] = act
             handle.on_click(callback)
         else:
             self._good[id(handle)] = handle.value
@@ -171,6 +173,15 @@ class Controls:
             self._revert(handle)
 
     on_input = _on_input  # for panels built elsewhere (viz/panels/gain_panel.py)
+
+    def press(self, button: viser.GuiButtonHandle, client: viser.ClientHandle | None) -> None:
+        """Do what a click on ``button`` by ``client`` does (a keyboard command): the same session command,
+        refused for a watcher the same way."""
+        self._apply(button, client, None, self._button_acts[id(button)], check=False, keep=False)
+
+    def act(self, handle: Any, client: viser.ClientHandle | None, act: Act) -> None:
+        """Run ``act(None, client_id)`` as ``client``'s input on ``handle`` (refused for a watcher)."""
+        self._apply(handle, client, None, act, check=False, keep=False)
 
     def _wire(self) -> None:
         g, s = self.gui, self.session

@@ -23,7 +23,7 @@ from rns_viz.viz.scene.view_toggles import ViewToggles
 
 # What each lesson draws (the rest can be ticked by hand): only what the lesson has explained so far,
 # so TREP's first lesson shows no ghost (its suppression is lesson 4's subject) and no n (lesson 3's).
-BASICS = ("reaction", "trail")
+BASICS = ("reaction", "trail", "labels")
 LESSON_VIEWS: dict[str, tuple[str, ...]] = {
     "trep-spring": BASICS,
     "trep-pushing-motion": (*BASICS, "coupling"),

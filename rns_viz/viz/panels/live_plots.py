@@ -137,7 +137,6 @@ class LivePlots:
     def __init__(self, gui: viser.GuiApi) -> None:
         linear: viser.uplot.Scale = {"auto": True}
         # charts take no hint: their meaning in plain words
-        self.caption = gui.add_html(PLOTS_CAPTION.format(runs=RUNS_SENTENCE["suppression"]))
         # (runs, scale, quantity, unit) -> chart: one per legend (a chart's series names cannot change),
         # scale and display unit (nor can its axis); the error chart's runs and scale are None
         self.chart_set: dict[tuple[str | None, str | None, str, str], viser.GuiUplotHandle] = {}
@@ -159,6 +158,7 @@ class LivePlots:
                 gui, "End-effector error", f"|e| ({unit})", (("|x_ref − x_e|", ERROR_COLOUR),), linear, False
             )
         self.peaks = gui.add_html(peaks_html(None))
+        self.caption = gui.add_html(PLOTS_CAPTION.format(runs=RUNS_SENTENCE["suppression"]))  # below: plots first
         self.scale = gui.add_dropdown(
             "Plot scale",
             tuple(SCALES.values()),

@@ -19,6 +19,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.paths import ReactionlessPath
 from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.scene.boom_drawing import BoomDrawing
+from rns_viz.viz.scene.framing import DEFAULT_ASPECT, DEFAULT_FOV, CameraPose, band_for, frame_points, framed_points
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.scene.shapes import Trail, path_colours, path_family_segments, polyline_segments
@@ -133,6 +134,7 @@ class FsmsScene:
             visible=False,
         )
         self._add_labels()
+        self.framed = framed_points(model)  # world points the camera frames
         self.set_initial_camera()
         self.q = model.q(model.spec.default_configuration)
         self.exaggeration = 1.0
@@ -231,16 +233,31 @@ class FsmsScene:
 
     # -- camera --------------------------------------------------------------------------------
     def set_initial_camera(self, clients: bool = True) -> None:
-        """The model's camera for new clients and Reset View; ``clients`` also moves connected ones."""
-        st = self.style
+        """The framed view for new clients (viser's Reset View); ``clients`` also frames connected ones."""
+        pose = self.camera_pose()
         cam = self.server.initial_camera
-        cam.position = st.camera_position
-        cam.look_at = st.camera_look_at
-        cam.near = 0.005 * float(np.linalg.norm(np.subtract(st.camera_position, st.camera_look_at)))
+        cam.position = pose.position
+        cam.look_at = pose.look_at
+        cam.near = 0.005 * float(np.linalg.norm(pose.position - pose.look_at))
         if clients:
             for client in self.server.get_clients().values():
-                client.camera.position = st.camera_position
-                client.camera.look_at = st.camera_look_at
+                self.frame_client(client)
+
+    def camera_pose(self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, width_px: int = 0) -> CameraPose:
+        """Where a camera of this field of view and aspect sees the robot framed (framing.py)."""
+        direction = np.subtract(self.style.camera_position, self.style.camera_look_at)
+        return frame_points(self.framed, direction, fov, aspect, band=band_for(width_px))
+
+    def frame_client(self, client: viser.ClientHandle) -> None:
+        """Point ``client``'s camera at the robot, framed for its page's size."""
+        cam = client.camera
+        width, height = cam.image_width, cam.image_height
+        aspect = width / height if width > 0 and height > 0 else DEFAULT_ASPECT
+        pose = self.camera_pose(cam.fov, aspect, width)
+        with client.atomic():
+            cam.up_direction = (0.0, 0.0, 1.0)
+            cam.position = pose.position  # (viser moves look_at with the position: it is set after)
+            cam.look_at = pose.look_at
 
     # -- internals -----------------------------------------------------------------------------
     def _trail_point(self) -> np.ndarray:

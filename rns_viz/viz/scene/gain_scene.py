@@ -149,6 +149,7 @@ class GainScene:
         self.legend = scene.add_label(
             f"{self.FRAME}/legend", "", position=(-0.5 * self.size, -0.5 * self.size - 5 * mark, 0.0), anchor="top-left"
         )
+        self.shown = False  # the Gain map toggle: the map and the authority overlay are drawn only while on
         self._ticks: list[object] = []
         self._paper: list[object] = []
         self._paper_key: tuple[tuple[str, float, float], ...] | None = None
@@ -196,7 +197,19 @@ class GainScene:
             self.show_now(view)
             self.title.text = _title(view, quantity)
             self.legend.text = _legend(quantity, self.scale)
-            self.frame.visible = True
+            self.frame.visible = self.shown
+
+    def set_shown(self, on: bool) -> bool:
+        """Draw the map (once computed) or hide it and the authority overlay; True if that changed (the
+        overlay is then drawn again by :meth:`show_authority`)."""
+        if on == self.shown:
+            return False
+        self.shown = on
+        with self.server.atomic():
+            self.frame.visible = on and self.gain_map is not None
+            if not on:
+                self.authority.visible = self.authority_lines.visible = False
+        return True
 
     def show_now(self, view: GainView) -> None:
         """The white marker at the gains in force (hidden outside the map's range)."""
@@ -287,7 +300,7 @@ class GainScene:
         """Colour the current path (TREP) or the reachable-set points (3R) by the predicted base decay
         rate (1/s) on the base mode map's colour scale; returns the colours drawn (K, 3) or None."""
         pts, auth = view.path_points, view.authority
-        if pts is None or auth is None or len(pts) != len(auth.base_decay_rate) or len(pts) < 2:
+        if not self.shown or pts is None or auth is None or len(pts) != len(auth.base_decay_rate) or len(pts) < 2:
             self.authority.visible = self.authority_lines.visible = False
             return None
         rates = np.asarray(auth.base_decay_rate, dtype=float)

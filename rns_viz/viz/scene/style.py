@@ -133,4 +133,4 @@ _BASE_KINDS: dict[type, type[BaseStyle] | None] = {
     NoDrawing: None,
 }
 # [app.scene] keys -> SceneStyle fields (the exaggeration and the base are not lengths of the scene style)
-_FIELD = {key: _unitless(key) for key in SceneTable.__struct_fields__ if key not in ("exaggeration", "base")}
+_FIELD = {key: _unitless(key) for key in SceneTable.__struct_fields__ if key not in ("exaggeration", "base", "shown")}

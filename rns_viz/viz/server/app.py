@@ -18,15 +18,19 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
 import viser
 
+from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.session import Session
 from rns_viz.live.operator.operator_lock import OperatorLock
+from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
 from rns_viz.viz.panels.control_panel import GuiElements, make_gui
 from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.panels.keys import add_key_commands, jog_step
 from rns_viz.viz.panels.lesson_panel import LessonPanel
 from rns_viz.viz.panels.model_menu import ModelMenu
 from rns_viz.viz.panels.path_words import PathWords
@@ -38,6 +42,9 @@ from rns_viz.viz.scene.view_toggles import make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
 from rns_viz.viz.server.render import TARGET_HANDLE, Renderer
 
+# Served only to this machine, the first page to connect is the presenter's and operates at once; served to
+# the network (e.g. --host 0.0.0.0), a phone that connects first must not: the seat waits for Take control.
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 IDLE_RESTART_S = 60.0  # s of simulated time: a session nobody watched this long restarts for its first visitor
 
 
@@ -51,18 +58,21 @@ class RnsApp:
         password: str | None = None,
         models: Sequence[str] = (),
         pace: bool = True,
+        seat_on_connect: bool = True,
     ) -> None:
-        """``models``: parameter files offered in the model dropdown besides the bundled models;
+        """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
+        presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files
+        offered in the model dropdown besides the bundled models;
         ``pace=False``: every page gets every update however slowly it draws."""
         self.server = server
         self.session = session
         self.password = password
-        self.connections = Connections(server, password)
+        self.connections = Connections(server, password, seat_on_connect)
         model = session.snapshot().settings.model
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
         self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
-        self.view = make_view_toggles(server, self.connections)
+        self.view = make_view_toggles(server.gui, self.connections, defaults_for(model).shown)
         self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
         self.lessons = LessonPanel(
             server, session, self.connections, self.gui.status.order + 0.5, self.view, self.gui.menu.keys.values()
@@ -77,6 +87,8 @@ class RnsApp:
         self.renderer.text_panels += [self.replay.refresh, self.rank_inset.refresh]
         # each page gets updates at the rate it can draw; told so under the status line when slowed
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
+        self.keys = add_key_commands(server.gui, self.gui, self.controls, session, self.frame_robot, self._jog_setup)
+        self.gui.frame_robot.on_click(lambda event: self.frame_robot(event.client))
         start = session.snapshot()
         self._unwatched_since: tuple[int, float] | None = (start.epoch, start.t)  # (epoch, t) the last client left
         self._visitors = threading.Lock()
@@ -122,6 +134,18 @@ class RnsApp:
     def render_thread(self) -> threading.Thread:
         return self.renderer.thread
 
+    def frame_robot(self, client: viser.ClientHandle | None) -> None:
+        """Point ``client``'s camera at the robot (every client's for the server's own call, None)."""
+        if client is None:
+            self.scene.set_initial_camera(clients=True)
+        else:
+            self.scene.frame_client(client)
+
+    def _jog_setup(self) -> tuple[np.ndarray, float, bool]:
+        """For a jog key: the target now (base frame, m), the step (m), whether it is spatial."""
+        snap = self.session.snapshot()
+        return self.renderer.home(snap), jog_step(arm_reach(self.model)), self.controls.spatial_target
+
     def good(self, handle: Any) -> Any:
         """The last good value of a GUI control (what the app acts on)."""
         return self.controls.good(handle)
@@ -142,6 +166,14 @@ class RnsApp:
         back after a moment) keeps the simulation, its recording and, for the operator's page, control."""
         self.connections.client_joined(client)
         self.pace.client_joined(client)
+        framed = threading.Event()
+
+        @client.camera.on_update
+        def _(_: viser.CameraHandle) -> None:  # the page's first camera message tells its size: frame for it
+            if not framed.is_set() and client.camera.image_width > 0:
+                framed.set()
+                self.scene.frame_client(client)
+
         with self._visitors:
             since, self._unwatched_since = self._unwatched_since, None
             if since is not None:  # nobody watched since then (a reload's page arrives while the old one is here)
@@ -183,7 +215,7 @@ def start_app(
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password, models, pace=pace).start()
+        app = RnsApp(server, session, password, models, pace=pace, seat_on_connect=host in LOOPBACK_HOSTS).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:

@@ -44,6 +44,9 @@ PLOT_S = 1.0 / 15.0  # live plots at 15 Hz (13 Hz when crowded)
 TEXT_S = 0.2  # status line and readouts at 5 Hz
 TARGET_HANDLE = "/base/target_handle"
 REACTION_LABEL = "arm reaction"
+KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
+# the names written in the scene that the *Labels* toggle hides (arrows' labels follow their arrows)
+LABELS = ("/base/label", "/beam/label", "/boom/label", "/spring/label", f"{TARGET_HANDLE}/label")
 
 
 class Renderer:
@@ -106,7 +109,7 @@ class Renderer:
             active_axes=(True, True, spatial),
             disable_rotations=True,
             depth_test=False,
-            position=self._home(snap) + np.array([0.0, 0.0, st.overlay_z]),
+            position=self.home(snap) + np.array([0.0, 0.0, st.overlay_z]),
         )
         self.handle.on_update(self.controls.on_drag)
         self.controls.spatial_target = spatial
@@ -124,7 +127,7 @@ class Renderer:
         self.scene.set_target(snap.target)
         self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
 
-    def _home(self, snap: Snapshot) -> np.ndarray:
+    def home(self, snap: Snapshot) -> np.ndarray:
         """Where the target handle rests: the session's target, else the end effector."""
         if snap.target is not None:
             return np.asarray(snap.target, dtype=float)
@@ -145,6 +148,8 @@ class Renderer:
             g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
+        kept = {name for name in KEPT_ACROSS_MODELS if self.view.on(name)}  # the viewer's choice, not the model's
+        self.view.show_only(defaults.shown | kept)  # the new model's first look
         self._seen = _Seen()
         self.sync_settings(snap)
         self.model_name = snap.settings.model
@@ -180,6 +185,7 @@ class Renderer:
         exaggeration = float(self.controls.good(self.gui.exaggeration))
         q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
         self.teach.draw(snap, q_shadow, exaggeration, self.view)
+        self._apply_view()
         self.rank.draw(self.view.on("rank"))
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
@@ -199,6 +205,23 @@ class Renderer:
         if now >= seen.next_text:
             seen.next_text = now + TEXT_S
             self._update_text(snap)
+
+    def _apply_view(self) -> None:
+        """The toggles of *Show in the scene* the render thread owns: labels, other paths, the gain map."""
+        seen, view = self._seen, self.view
+        labels = view.on("labels")
+        if labels != seen.labels:
+            seen.labels = labels
+            for name in LABELS:
+                handle = self.server.scene.get_handle_by_name(name)
+                if handle is not None:
+                    handle.visible = labels
+            self.teach.ghost.label.visible = labels
+        paths = view.on("paths")
+        if paths != seen.paths:
+            seen.paths = paths
+            seen.overlay_version = -1  # redrawn with or without the family
+        self.explorer.show(view.on("gain_map"))
 
     def _draw_state(self, snap: Snapshot) -> None:
         """The arm, the base and the reaction arrow, when what a viewer sees changed."""
@@ -224,7 +247,7 @@ class Renderer:
         pose = snap.orientation is not None and snap.orientation.on  # a pose handle: rotation rings too
         if snap.target_version != seen.target_version or pose != seen.pose:
             seen.target_version, seen.pose = snap.target_version, pose
-            home = self._home(snap)
+            home = self.home(snap)
             if np.all(np.isfinite(home)):
                 self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
             self.handle.disable_rotations, self.controls.pose_target = not pose, pose
@@ -250,7 +273,7 @@ class Renderer:
         if ov.model != self.model_name:  # a switch published after this frame's snapshot: drawn once rebuilt
             self._seen.overlay_version = -1
             return
-        curves = list(ov.family or [])
+        curves = list(ov.family or []) if self.view.on("paths") else []  # the current path is always drawn
         if ov.current is not None:
             curves.append(ov.current)
         if curves:
@@ -305,7 +328,7 @@ class Renderer:
         """While a preset runs its own motion (no target) the handle stays on the end effector."""
         if snap.settings.preset is None or snap.target is not None or not np.all(np.isfinite(snap.q)):
             return
-        home = self._home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
+        home = self.home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
         if np.linalg.norm(home - np.asarray(self.handle.position)) > 0.5 * self.scene.style.marker_radius:
             self.handle.position = home
 
@@ -371,3 +394,5 @@ class _Seen:
         self.next_plot = 0.0
         self.next_text = 0.0
         self.plot_mode = ""
+        self.labels: bool | None = None  # the view toggles last applied
+        self.paths: bool | None = None
