@@ -230,6 +230,13 @@ def cmd_serve(args: argparse.Namespace) -> None:
         if args.lesson > count:
             raise CliError(f"{model} has lessons 1 to {count}, not {args.lesson}")
     extra = [name for name in models if name.endswith(".toml")]
+    if args.each_visitor:
+        from rns_viz.viz.server.classroom import serve_classroom
+
+        if args.lesson is not None:
+            raise CliError("--lesson and --each-visitor do not go together: each visitor starts their own lessons")
+        serve_classroom(model, args.host, args.port, extra, args.max_visitors, args.idle_minutes)
+        return
     serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)
 
 
@@ -287,6 +294,25 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
     serve.add_argument("--lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
+    serve.add_argument(
+        "--each-visitor",
+        action="store_true",
+        help="give every browser page its own simulation (a lab room on one machine; see docs/deploy/classroom.md)",
+    )
+    serve.add_argument(
+        "--max-visitors",
+        metavar="N",
+        type=_positive_int,
+        default=None,
+        help="with --each-visitor: simulations at once (default 3 per CPU core); later pages wait for a place",
+    )
+    serve.add_argument(
+        "--idle-minutes",
+        metavar="M",
+        type=_positive_float,
+        default=20.0,
+        help="with --each-visitor: close a simulation after M minutes without input (paused after M/4, at most 5)",
+    )
     serve.set_defaults(func=cmd_serve)
     return parser
 

@@ -1,0 +1,321 @@
+"""A simulation for every visitor: one viser server, one :class:`~rns_viz.live.loop.session.Session` and one
+:class:`~rns_viz.viz.server.app.RnsApp` per browser page (``rns-viz serve --each-visitor``).
+
+Each visitor's app is built on a :class:`~rns_viz.viz.clients.client_view.ClientView`, so its panel, scene
+and plots live in viser's per-client scope: no other page sees them, and the app's code is the same as
+when one simulation is shared. The rules of the room:
+
+- At most ``max_visitors`` simulations run at once (default :func:`default_visitor_cap`). A page that comes
+  when all are taken is told so and waits; it gets a simulation as soon as one is free, without a reload.
+- A visitor who gives no input (a GUI change, a drag, a click, a camera move) for ``idle_pause_s`` has the
+  simulation paused (their next input resumes it); after ``idle_close_s`` it is closed and its place given
+  to the next waiting page, and the page offers to start a new one.
+- A page that leaves frees its simulation: the render and simulation threads end and the session is
+  released.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from collections.abc import Callable, Sequence
+from contextlib import suppress
+from dataclasses import dataclass, field
+from typing import Any, cast
+
+import viser
+import viser._messages as viser_messages
+
+from rns_viz.live.loop.session import Session
+from rns_viz.viz.clients.client_view import ClientView
+from rns_viz.viz.server.app import RnsApp
+
+VISITORS_PER_CORE = 3  # simulations per CPU core that keep real time (benchmarks/bench_visitors.py)
+IDLE_PAUSE_S = 5 * 60.0  # wall s without input before a visitor's simulation is paused
+IDLE_CLOSE_S = 20 * 60.0  # wall s without input before it is closed and its place freed
+IDLE_CHECK_S = 5.0  # wall s between looks for idle visitors
+# What a person's hand sends: any GUI change, a drag or click in the scene, a camera move.
+INPUT_MESSAGES: tuple[type, ...] = tuple(
+    kind
+    for name in (
+        "GuiUpdateMessage",
+        "TransformControlsUpdateMessage",
+        "TransformControlsDragStartMessage",
+        "SceneNodeClickMessage",
+        "SceneNodeDragMessage",
+        "ViewerCameraMessage",
+    )
+    if isinstance(kind := getattr(viser_messages, name, None), type)
+)
+FULL_TEXT = (
+    "**This class is full.** All {cap} simulations are in use. This page waits and starts yours as soon as "
+    "one is free; there is no need to reload. You are number {place} in the queue."
+)
+CLOSED_TEXT = (
+    "**Your simulation was closed** after {minutes:g} minutes without input, to make room for others. "
+    "Press the button to start a new one."
+)
+
+
+def default_visitor_cap(cores: int | None = None) -> int:
+    """How many simulations this machine runs at once in real time: VISITORS_PER_CORE per core."""
+    return max(1, VISITORS_PER_CORE * (cores or os.cpu_count() or 1))
+
+
+@dataclass
+class Visitor:
+    """One page: its view of the server and, while it holds a place, its session and app."""
+
+    view: ClientView
+    app: RnsApp | None = None
+    last_input: float = field(default_factory=time.monotonic)
+    opening: bool = False  # its app is being built (it holds a place already)
+    idle_paused: bool = False  # paused by the idle rule (the next input resumes it)
+    notice: Any = None  # the waiting / closed message in the page's panel
+    start_again: Any = None  # the button under a "closed" message
+
+
+class Classroom:
+    """The visitors of one server and the rules above."""
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        model: str = "trep",
+        models: Sequence[str] = (),
+        max_visitors: int | None = None,
+        idle_pause_s: float = IDLE_PAUSE_S,
+        idle_close_s: float = IDLE_CLOSE_S,
+        make_session: Callable[[str], Session] | None = None,
+    ) -> None:
+        """``make_session``: how a visitor's session is made (default: real time; tests step their own)."""
+        self.server = server
+        self.model = model
+        self.models = tuple(models)
+        self.max_visitors = max_visitors or default_visitor_cap()
+        self.idle_pause_s = idle_pause_s
+        self.idle_close_s = idle_close_s
+        self.make_session = make_session or (lambda name: Session(name, realtime=True))
+        self.visitors: dict[int, Visitor] = {}
+        self.waiting: list[int] = []  # pages without a place, in order of arrival
+        self._guard = threading.RLock()
+        self._stop = threading.Event()
+        self._watcher = threading.Thread(target=self._watch_idle, name="rns-idle", daemon=True)
+        for kind in INPUT_MESSAGES:
+            server._websock_server.register_handler(kind, self._input)  # every page's input, by client id
+        server.on_client_connect(self._joined)
+        server.on_client_disconnect(self._left)
+        self._watcher.start()
+
+    # ---------------------------------------------------------------- readers
+    def apps(self) -> dict[int, RnsApp]:
+        """The running apps by client id."""
+        with self._guard:
+            return {cid: v.app for cid, v in self.visitors.items() if v.app is not None}
+
+    def running(self) -> int:
+        """Places taken: simulations running or being started."""
+        with self._guard:
+            return sum(v.app is not None or v.opening for v in self.visitors.values())
+
+    def notice_text(self, client_id: int) -> str | None:
+        """The waiting / closed message a page shows (None: it has a simulation)."""
+        with self._guard:
+            visitor = self.visitors.get(client_id)
+            notice = None if visitor is None else visitor.notice
+        return None if notice is None else notice.content
+
+    def stop(self) -> None:
+        self._stop.set()
+        with self._guard:
+            visitors = list(self.visitors.values())
+        for visitor in visitors:
+            self._close(visitor)
+        self.server.stop()
+
+    @property
+    def port(self) -> int:
+        return self.server.get_port()
+
+    # ---------------------------------------------------------------- arrivals and departures
+    def _joined(self, client: viser.ClientHandle) -> None:
+        visitor = Visitor(ClientView(self.server, client))
+        with self._guard:
+            self.visitors[client.client_id] = visitor
+            self.waiting.append(client.client_id)
+        self._admit_waiting()
+
+    def _left(self, client: viser.ClientHandle) -> None:
+        with self._guard:
+            visitor = self.visitors.pop(client.client_id, None)
+            with suppress(ValueError):
+                self.waiting.remove(client.client_id)
+        if visitor is not None:
+            visitor.view.client_left()  # the app's own disconnect handling (a drag ended, control passed on)
+            self._close(visitor)
+        self._admit_waiting()
+
+    def _admit_waiting(self) -> None:
+        """Give free places to waiting pages, first come first served; tell the rest where they stand."""
+        while True:
+            with self._guard:
+                if not self.waiting or self.running() >= self.max_visitors:
+                    break
+                visitor = self.visitors[self.waiting.pop(0)]
+                visitor.opening = True  # holds the place while the app is built (outside the lock)
+                visitor.last_input, visitor.idle_paused = time.monotonic(), False
+            try:
+                self._open(visitor)
+            finally:
+                visitor.opening = False
+        with self._guard:
+            queue = [self.visitors[cid] for cid in self.waiting]
+        for place, visitor in enumerate(queue, start=1):
+            self._show(visitor, FULL_TEXT.format(cap=self.max_visitors, place=place))
+
+    def _open(self, visitor: Visitor) -> None:
+        """Build the visitor's session and app (its panel and scene, on its page only)."""
+        self._clear_notice(visitor)
+        session = self.make_session(self.model)
+        try:
+            view = cast(viser.ViserServer, visitor.view)  # the app uses only what ClientView provides
+            app = RnsApp(view, session, password=None, models=self.models, pace=False).start()
+        except Exception:
+            session.stop()
+            raise
+        with self._guard:
+            gone = visitor.view.client.client_id not in self.visitors
+            visitor.app = app
+        if gone:  # the page left while its app was built
+            self._close(visitor)
+
+    def _close(self, visitor: Visitor) -> None:
+        """End the visitor's simulation: its threads stopped, its panel and scene removed from the page."""
+        with self._guard:
+            app, visitor.app = visitor.app, None
+        if app is None:
+            return
+        app.stop()  # the render thread, then the session's loop; the shared server stays
+        if visitor.view.connected:
+            with suppress(Exception):
+                visitor.view.gui.reset()
+                visitor.view.scene.reset()
+
+    # ---------------------------------------------------------------- idle visitors
+    def _input(self, client_id: int, _message: object) -> None:
+        """A page sent input: it is not idle; a simulation paused for idleness runs again."""
+        with self._guard:
+            visitor = self.visitors.get(client_id)
+            if visitor is None:
+                return
+            visitor.last_input = time.monotonic()
+            resume, visitor.idle_paused = visitor.idle_paused, False
+            app = visitor.app
+        if resume and app is not None:
+            app.session.resume()
+
+    def _watch_idle(self) -> None:
+        while not self._stop.wait(IDLE_CHECK_S):
+            self.check_idle()
+
+    def check_idle(self, now: float | None = None) -> None:
+        """Pause the simulations idle for ``idle_pause_s``, close those idle for ``idle_close_s``."""
+        now = time.monotonic() if now is None else now
+        with self._guard:
+            visitors = [v for v in self.visitors.values() if v.app is not None]
+        closed = False
+        for visitor in visitors:
+            idle = now - visitor.last_input
+            app = visitor.app
+            if app is None:
+                continue
+            if idle >= self.idle_close_s:
+                self._close(visitor)
+                self._offer_start_again(visitor)
+                closed = True
+            elif idle >= self.idle_pause_s and not visitor.idle_paused:
+                visitor.idle_paused = True
+                app.session.pause()
+                minutes = self.idle_pause_s / 60.0
+                with suppress(Exception):
+                    visitor.view.client.add_notification(
+                        "Paused", f"Paused after {minutes:g} minutes without input; any input resumes it.", color="blue"
+                    )
+        if closed:
+            self._admit_waiting()
+
+    def _offer_start_again(self, visitor: Visitor) -> None:
+        self._show(visitor, CLOSED_TEXT.format(minutes=self.idle_close_s / 60.0))
+        with suppress(Exception):
+            button = visitor.view.gui.add_button("Start a new simulation")
+            visitor.start_again = button
+            button.on_click(lambda _: self._start_again(visitor))
+
+    def _start_again(self, visitor: Visitor) -> None:
+        cid = visitor.view.client.client_id
+        with self._guard:
+            if cid not in self.visitors or visitor.app is not None or cid in self.waiting:
+                return
+            self.waiting.append(cid)
+        self._admit_waiting()
+
+    # ---------------------------------------------------------------- the page's message
+    def _show(self, visitor: Visitor, text: str) -> None:
+        with suppress(Exception):  # the page may have gone
+            if visitor.notice is None:
+                visitor.notice = visitor.view.gui.add_markdown(text)
+            elif visitor.notice.content != text:
+                visitor.notice.content = text
+
+    def _clear_notice(self, visitor: Visitor) -> None:
+        for handle in (visitor.notice, visitor.start_again):
+            if handle is not None:
+                with suppress(Exception):
+                    handle.remove()
+        visitor.notice = visitor.start_again = None
+
+
+def start_classroom(
+    model: str = "trep",
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    models: Sequence[str] = (),
+    max_visitors: int | None = None,
+    idle_pause_s: float = IDLE_PAUSE_S,
+    idle_close_s: float = IDLE_CLOSE_S,
+    verbose: bool = True,
+    make_session: Callable[[str], Session] | None = None,
+) -> Classroom:
+    """Start a server that gives every visitor their own simulation; returns at once (``port=0``: a free
+    port)."""
+    server = viser.ViserServer(host=host, port=port, verbose=verbose)
+    server.gui.set_panel_label("rns_viz: reaction null-space control")
+    try:
+        return Classroom(server, model, models, max_visitors, idle_pause_s, idle_close_s, make_session)
+    except Exception:
+        server.stop()
+        raise
+
+
+def serve_classroom(
+    model: str = "trep",
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    models: Sequence[str] = (),
+    max_visitors: int | None = None,
+    idle_minutes: float = IDLE_CLOSE_S / 60.0,
+) -> None:
+    """Serve a simulation per visitor until interrupted (Ctrl+C)."""
+    close_s = idle_minutes * 60.0
+    room = start_classroom(model, host, port, models, max_visitors, min(IDLE_PAUSE_S, close_s / 4.0), close_s)
+    print(
+        f"rns_viz, a simulation per visitor (at most {room.max_visitors}): http://{host}:{room.port}  (Ctrl+C to stop)"
+    )
+    try:
+        while True:
+            time.sleep(3600.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        room.stop()
