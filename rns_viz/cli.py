@@ -82,6 +82,24 @@ def _load_model(name: str) -> FsmsModel:
     return FsmsModel.from_file(name) if name.endswith(".toml") else FsmsModel.from_name(name)
 
 
+def _models_in(folder: Path) -> list[str]:
+    """The model keys of the parameter files (``*.toml``) in ``folder`` that read as models; each one that
+    does not is named on stderr and left out (a folder of a student's files must not stop the app)."""
+    if not folder.is_dir():
+        if folder.exists():
+            raise CliError(f"--model-dir {folder}: not a folder")
+        return []
+    keys = []
+    for path in sorted(folder.glob("*.toml")):
+        try:
+            _load_model(str(path))
+        except (ModelFileError, OSError) as exc:
+            print(f"rns-viz: skipping {path}: {exc}", file=sys.stderr)
+            continue
+        keys.append(model_key(str(path)))
+    return keys
+
+
 def _open_for_writing(path: Path):
     try:
         return path.open("w", newline="")
@@ -220,6 +238,8 @@ def cmd_serve(args: argparse.Namespace) -> None:
     models = [model_key(name) for name in args.model or ["trep"]]  # files by absolute path: one key each
     for name in models:  # every file is read and checked now: a bad one is refused before serving
         _load_model(name)
+    if args.model_dir is not None:
+        models += [name for name in _models_in(Path(args.model_dir)) if name not in models]
     model = models[0]
     if args.lesson is not None:
         from rns_viz.live.teaching.lessons import LESSONS
@@ -289,6 +309,12 @@ def build_parser() -> argparse.ArgumentParser:
         type=_model_arg,
         action="append",
         help=MODEL_HELP + "; the first is served, every file joins the model dropdown (repeat to add more)",
+    )
+    serve.add_argument(
+        "--model-dir",
+        metavar="DIR",
+        default=None,
+        help="every model parameter file (*.toml) in DIR joins the model dropdown (files that do not read are skipped)",
     )
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     serve.add_argument("--port", type=_port, default=8080)
