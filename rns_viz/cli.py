@@ -255,6 +255,11 @@ def cmd_serve(args: argparse.Namespace) -> None:
 
         if args.lesson is not None:
             raise CliError("--lesson and --each-visitor do not go together: each visitor starts their own lessons")
+        if password is not None:
+            raise CliError(
+                "--password has no use with --each-visitor: every visitor operates their own simulation, and the "
+                "presenter is the page opened on this machine"
+            )
         serve_classroom(model, args.host, args.port, extra, args.max_visitors, args.idle_minutes)
         return
     serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)

@@ -150,3 +150,38 @@ def test_an_idle_visitor_is_paused_then_closed_and_may_start_again(room: Classro
     wait_until(lambda: cid in room.apps(), 60.0, "a new simulation for the page")
     assert room.apps()[cid] is not app and room.notice_text(cid) is None
     page.close()
+
+
+def test_the_presenter_shows_their_simulation_on_every_page_view_only(room: Classroom) -> None:
+    """Only the first page is the presenter's here. While it shows its simulation, the other page draws the
+    presenter's session (its own paused) and its inputs are refused with a message; unticked, the page gets
+    its own simulation back, running again."""
+    room.is_presenter = lambda cid: not room.visitors  # the first page to arrive
+    (a, app_a), (b, app_b) = visitors(room, 2)
+    a_id, b_id = sorted(room.apps())
+    assert room.visitors[b_id].extra is None  # no switch on a student's page
+    own_b = app_b.session
+    a.set_value(uuid(room.visitors[a_id].extra), True)
+    wait_until(lambda: room.visitors[b_id].watching and room.visitors[b_id].app is not None, 30.0, "B to watch")
+    watching = room.apps()[b_id]
+    own_b.advance(0.01)
+    assert watching.session.snapshot() is app_a.session.snapshot() and own_b.snapshot().paused
+    assert not app_b.render_thread.is_alive()  # B's own app is off its page
+
+    a.click(uuid(app_a.gui.kick))  # the presenter drives
+    wait_until(lambda: app_a.session.pending_commands(), 10.0, "the presenter's kick")
+    app_a.session.advance(KICK_S)
+    assert app_a.session.state.kicks_sent == 1 and base_swing(app_a) > 1e-4
+    b.click(uuid(watching.gui.kick))  # a watcher's kick goes nowhere, and the watcher is told
+    wait_until(lambda: any(t == "Watching the presenter" for t, _ in b.notifications), 10.0, "the refusal")
+    app_a.session.advance(0.01)
+    assert app_a.session.state.kicks_sent == 1 and own_b.state.kicks_sent == 0
+
+    a.set_value(uuid(room.visitors[a_id].extra), False)
+    wait_until(lambda: not room.visitors[b_id].watching and room.visitors[b_id].app is not None, 30.0, "B's own")
+    back = room.apps()[b_id]
+    own_b.advance(0.01)
+    assert back.session is own_b and not own_b.snapshot().paused and not watching.render_thread.is_alive()
+    assert room.apps()[a_id] is app_a  # the presenter's app was never touched
+    a.close()
+    b.close()

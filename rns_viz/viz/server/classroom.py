@@ -12,6 +12,8 @@ when one simulation is shared. The rules of the room:
   to the next waiting page, and the page offers to start a new one.
 - A page that leaves frees its simulation: the render and simulation threads end and the session is
   released.
+- The page opened on the server's machine is the presenter's: it may show its simulation on every other
+  page (:mod:`rns_viz.viz.server.presenter`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import os
 import threading
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
@@ -30,6 +33,7 @@ import viser._messages as viser_messages
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.clients.client_view import ClientView
 from rns_viz.viz.server.app import RnsApp
+from rns_viz.viz.server.presenter import WatchedSession, add_show_switch, add_watching_line, is_loopback, refuser
 
 VISITORS_PER_CORE = 3  # simulations per CPU core that keep real time (benchmarks/bench_visitors.py)
 IDLE_PAUSE_S = 5 * 60.0  # wall s without input before a visitor's simulation is paused
@@ -65,10 +69,16 @@ def default_visitor_cap(cores: int | None = None) -> int:
 
 @dataclass
 class Visitor:
-    """One page: its view of the server and, while it holds a place, its session and app."""
+    """One page: its view of the server and, while it holds a place, its session and the app it shows (on
+    its own session, or on the presenter's while the presenter shows theirs)."""
 
     view: ClientView
+    presenter: bool = False  # may show its simulation on every other page
+    session: Session | None = None
     app: RnsApp | None = None
+    watching: bool = False  # the app shows the presenter's session
+    resume_after_watch: bool = False  # the own session ran when watching began
+    extra: Any = None  # the presenter's switch, or the watcher's line, in the page's panel
     last_input: float = field(default_factory=time.monotonic)
     opening: bool = False  # its app is being built (it holds a place already)
     idle_paused: bool = False  # paused by the idle rule (the next input resumes it)
@@ -88,8 +98,10 @@ class Classroom:
         idle_pause_s: float = IDLE_PAUSE_S,
         idle_close_s: float = IDLE_CLOSE_S,
         make_session: Callable[[str], Session] | None = None,
+        is_presenter: Callable[[int], bool] | None = None,
     ) -> None:
-        """``make_session``: how a visitor's session is made (default: real time; tests step their own)."""
+        """``make_session``: how a visitor's session is made (default: real time; tests step their own);
+        ``is_presenter(client_id)``: whose page may show its simulation to all (default: this machine's)."""
         self.server = server
         self.model = model
         self.models = tuple(models)
@@ -97,6 +109,8 @@ class Classroom:
         self.idle_pause_s = idle_pause_s
         self.idle_close_s = idle_close_s
         self.make_session = make_session or (lambda name: Session(name, realtime=True))
+        self.is_presenter = is_presenter or (lambda cid: is_loopback(server, cid))
+        self.showing: int | None = None  # the presenter whose simulation every page shows
         self.visitors: dict[int, Visitor] = {}
         self.waiting: list[int] = []  # pages without a place, in order of arrival
         self._guard = threading.RLock()
@@ -140,7 +154,7 @@ class Classroom:
 
     # ---------------------------------------------------------------- arrivals and departures
     def _joined(self, client: viser.ClientHandle) -> None:
-        visitor = Visitor(ClientView(self.server, client))
+        visitor = Visitor(ClientView(self.server, client), presenter=self.is_presenter(client.client_id))
         with self._guard:
             self.visitors[client.client_id] = visitor
             self.waiting.append(client.client_id)
@@ -154,6 +168,8 @@ class Classroom:
         if visitor is not None:
             visitor.view.client_left()  # the app's own disconnect handling (a drag ended, control passed on)
             self._close(visitor)
+        if self.showing == client.client_id:
+            self.show(None)
         self._admit_waiting()
 
     def _admit_waiting(self) -> None:
@@ -175,32 +191,88 @@ class Classroom:
             self._show(visitor, FULL_TEXT.format(cap=self.max_visitors, place=place))
 
     def _open(self, visitor: Visitor) -> None:
-        """Build the visitor's session and app (its panel and scene, on its page only)."""
+        """Make the visitor's session and the app its page shows."""
         self._clear_notice(visitor)
-        session = self.make_session(self.model)
+        visitor.session = self.make_session(self.model)
         try:
-            view = cast(viser.ViserServer, visitor.view)  # the app uses only what ClientView provides
-            app = RnsApp(view, session, password=None, models=self.models, pace=False).start()
+            self._build(visitor)
         except Exception:
-            session.stop()
+            self._close(visitor)
             raise
         with self._guard:
             gone = visitor.view.client.client_id not in self.visitors
-            visitor.app = app
         if gone:  # the page left while its app was built
             self._close(visitor)
 
-    def _close(self, visitor: Visitor) -> None:
-        """End the visitor's simulation: its threads stopped, its panel and scene removed from the page."""
+    def _build(self, visitor: Visitor) -> None:
+        """The app on the visitor's page (its panel and scene, on that page only): on its own session, or,
+        while a presenter shows theirs, on the presenter's, view only."""
+        assert visitor.session is not None
+        client = visitor.view.client
+        with self._guard:
+            source = self.visitors.get(self.showing) if self.showing not in (None, client.client_id) else None
+        watched = source.session if source is not None else None
+        session: Any = visitor.session
+        if watched is not None:
+            if not visitor.watching:  # its own simulation pauses while it watches
+                visitor.resume_after_watch = not visitor.session.snapshot().paused
+                visitor.session.pause()
+            session = WatchedSession(watched, refuser(client))
+        visitor.view = ClientView(self.server, client)  # a fresh view: the old app's callbacks stay with the old
+        view = cast(viser.ViserServer, visitor.view)  # the app uses only what ClientView provides
+        app = RnsApp(view, session, password=None, models=self.models, pace=False).start()
+        with suppress(Exception):  # the page may have gone
+            if watched is not None:
+                visitor.extra = add_watching_line(client)
+            elif visitor.presenter:
+                cid = client.client_id
+                visitor.extra = add_show_switch(client, self.showing == cid, lambda on: self.show(cid if on else None))
+        with self._guard:
+            visitor.app, visitor.watching = app, watched is not None
+
+    def _detach(self, visitor: Visitor) -> None:
+        """Take the app off the visitor's page (its threads stopped, its panel and scene removed); the
+        visitor's session is left as it is."""
         with self._guard:
             app, visitor.app = visitor.app, None
         if app is None:
             return
-        app.stop()  # the render thread, then the session's loop; the shared server stays
+        app.pace.stop()
+        app.renderer.stop()
+        visitor.extra = None
         if visitor.view.connected:
             with suppress(Exception):
                 visitor.view.gui.reset()
                 visitor.view.scene.reset()
+
+    def _close(self, visitor: Visitor) -> None:
+        """End the visitor's simulation: its app taken off the page and its session stopped."""
+        self._detach(visitor)
+        with self._guard:
+            session, visitor.session, visitor.watching = visitor.session, None, False
+        if session is not None:
+            session.stop()
+
+    # ---------------------------------------------------------------- the presenter
+    def show(self, presenter: int | None) -> None:
+        """Show the simulation of ``presenter`` (a client id) on every other page, or nobody's (None)."""
+        with self._guard:
+            if presenter is not None and not (presenter in self.visitors and self.visitors[presenter].presenter):
+                return
+            if presenter == self.showing:
+                return
+            before, self.showing = self.showing, presenter
+            others = [v for cid, v in self.visitors.items() if cid not in (presenter, before) and v.app is not None]
+        for visitor in others:
+            was_watching = visitor.watching
+            self._detach(visitor)
+            if visitor.session is None:
+                continue
+            if presenter is None and was_watching:
+                visitor.watching = False
+                if visitor.resume_after_watch:
+                    visitor.session.resume()
+            self._build(visitor)
 
     # ---------------------------------------------------------------- idle visitors
     def _input(self, client_id: int, _message: object) -> None:
@@ -211,9 +283,9 @@ class Classroom:
                 return
             visitor.last_input = time.monotonic()
             resume, visitor.idle_paused = visitor.idle_paused, False
-            app = visitor.app
-        if resume and app is not None:
-            app.session.resume()
+            session = None if visitor.watching else visitor.session
+        if resume and session is not None:
+            session.resume()
 
     def _watch_idle(self) -> None:
         while not self._stop.wait(IDLE_CHECK_S):
@@ -227,16 +299,16 @@ class Classroom:
         closed = False
         for visitor in visitors:
             idle = now - visitor.last_input
-            app = visitor.app
-            if app is None:
+            session = visitor.session
+            if session is None:
                 continue
             if idle >= self.idle_close_s:
                 self._close(visitor)
                 self._offer_start_again(visitor)
                 closed = True
-            elif idle >= self.idle_pause_s and not visitor.idle_paused:
+            elif idle >= self.idle_pause_s and not visitor.idle_paused and not visitor.watching:
                 visitor.idle_paused = True
-                app.session.pause()
+                session.pause()
                 minutes = self.idle_pause_s / 60.0
                 with suppress(Exception):
                     visitor.view.client.add_notification(
@@ -308,6 +380,9 @@ def serve_classroom(
 ) -> None:
     """Serve a simulation per visitor until interrupted (Ctrl+C)."""
     close_s = idle_minutes * 60.0
+    # A page that leaves may be sent a frame after its connection closed and before its app hears of it
+    # (viser warns once per page): expected here, not worth a line in the teacher's terminal per student.
+    warnings.filterwarnings("ignore", message="Queued a .* on a closed connection", category=UserWarning)
     room = start_classroom(model, host, port, models, max_visitors, min(IDLE_PAUSE_S, close_s / 4.0), close_s)
     print(
         f"rns_viz, a simulation per visitor (at most {room.max_visitors}): http://{host}:{room.port}  (Ctrl+C to stop)"
