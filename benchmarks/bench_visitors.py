@@ -71,11 +71,12 @@ def serve_visitors() -> None:
 
 
 def serve_student() -> None:
-    """One student's app, as the proxy starts it; answers 'stats' like :func:`serve_visitors`."""
+    """One student's app, as the proxy starts it (paused while no page is open); answers 'stats' like
+    :func:`serve_visitors`."""
     from rns_viz.viz.server.app import start_app
 
     out, sys.stdout = sys.stdout, sys.stderr
-    app = start_app("trep", port=0, verbose=False)
+    app = start_app("trep", port=0, verbose=False, pause_unwatched=True)
     watched = threading.Event()
     threading.Thread(target=kick_forever, args=(lambda: [app] if watched.is_set() else [],), daemon=True).start()
     print(json.dumps({"port": app.port, "pid": os.getpid()}), file=out, flush=True)
@@ -141,13 +142,15 @@ def window(child: Child, seconds: float) -> dict[str, Any]:
 
 
 def profile(pid: int, seconds: float) -> None:
-    """Where the server's time goes: py-spy's top functions by own time over ``seconds``."""
+    """Where the server's Python time goes: py-spy's samples of the thread holding the interpreter lock, by
+    thread and by function (own time) over ``seconds``."""
     if shutil.which("py-spy") is None:
         print("  (py-spy not installed: no profile)")
         return
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "profile.txt"
         cmd = ["py-spy", "record", "--pid", str(pid), "--duration", str(int(seconds)), "--format", "raw"]
+        cmd += ["--threads", "--gil"]  # samples of the thread holding the interpreter lock: where CPU time goes
         result = subprocess.run([*cmd, "--output", str(out), "--nonblocking"], capture_output=True, text=True)
         if result.returncode != 0 or not out.exists():
             print(f"  py-spy failed: {result.stderr.strip()[-300:]}")

@@ -262,7 +262,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
             )
         serve_classroom(model, args.host, args.port, extra, args.max_visitors, args.idle_minutes)
         return
-    serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)
+    serve(model, args.host, args.port, password, args.lesson, extra, pause_unwatched=args.pause_unwatched)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -325,6 +325,11 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
     serve.add_argument("--lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
+    serve.add_argument(
+        "--pause-unwatched",
+        action="store_true",
+        help="pause the simulation while no page is open (one student's app on JupyterHub: little CPU when idle)",
+    )
     serve.add_argument(
         "--each-visitor",
         action="store_true",

@@ -35,10 +35,11 @@ def model_dir() -> Path:
 
 
 def serve_command(port: int) -> list[str]:
-    """``rns-viz serve`` on loopback at ``port``, with the student's model folder (by this interpreter, so
-    the app runs in the Jupyter server's environment whatever is on PATH)."""
+    """``rns-viz serve`` on loopback at ``port``, with the student's model folder, paused while no page is
+    open (a closed tab costs little), by this interpreter (the Jupyter server's environment, whatever is on
+    PATH)."""
     cmd = [sys.executable, "-m", "rns_viz.cli", "serve", "--host", "127.0.0.1", "--port", str(port)]
-    return [*cmd, "--model-dir", str(model_dir())]
+    return [*cmd, "--model-dir", str(model_dir()), "--pause-unwatched"]
 
 
 def page_address(response: Any, path: str, request: Any) -> None:
