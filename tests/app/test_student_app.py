@@ -1,6 +1,6 @@
 """One student's app as jupyter-server-proxy starts it (``rns-viz serve --pause-unwatched``): the simulation
-pauses when the last page closes, so a forgotten server costs little, and runs on, where it was, when a page
-comes back. A simulation the student paused stays paused."""
+waits for the first page and pauses when the last page closes, so a forgotten server costs little, and runs
+on, where it was, when a page comes back. A simulation the student paused stays paused."""
 
 from __future__ import annotations
 
@@ -22,9 +22,13 @@ def app() -> Iterator[RnsApp]:
 
 def test_the_simulation_pauses_while_no_page_is_open_and_runs_on_when_one_comes(app: RnsApp) -> None:
     s = app.session
+    s.advance(0.1)
+    assert s.snapshot().paused and s.snapshot().t == 0.0  # nobody has opened the page yet
     page = ProtocolClient(app.port)
     wait_for_clients(app, 1, "the page")
+    wait_until(lambda: s.pending_commands(), 10.0, "the resume to be sent")
     s.advance(0.2)
+    assert not s.snapshot().paused
     t = s.snapshot().t
     page.close()
     wait_until(lambda: not app.server.get_clients() and s.pending_commands(), 10.0, "the pause to be sent")

@@ -82,7 +82,9 @@ class RnsApp:
         self._unwatched_since: tuple[int, float] | None = (start.epoch, start.t)  # (epoch, t) the last client left
         self._visitors = threading.Lock()
         self.pause_unwatched = pause_unwatched
-        self._paused_unwatched = False  # paused because the last page left (the next page resumes it)
+        self._paused_unwatched = pause_unwatched  # paused while no page is open (the next page resumes it)
+        if pause_unwatched:
+            session.pause()
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
