@@ -36,6 +36,8 @@ from typing import Any
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # tests/ holds the websocket client
 
+from benchmarks.bench_app import load  # noqa: E402 (the load average, as the other benchmarks print it)
+
 KICK_EVERY_S = 5.0  # wall s between kicks of each simulation
 SETTLE_S = 3.0  # wall s after a join before measuring (the new page's scene and GUI are sent)
 
@@ -45,10 +47,6 @@ def rss_mb(pid: int | str = "self") -> float:
         if line.startswith("VmRSS:"):
             return int(line.split()[1]) / 1024.0
     return float("nan")
-
-
-def load() -> str:
-    return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
 # ---------------------------------------------------------------- server side (child processes)
