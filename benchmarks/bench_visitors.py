@@ -10,7 +10,8 @@ Run on demand (the machine should be quiet: the load average is printed with eve
    websocket clients (tests/support/protocol_client.py) join one at a time and receive every update; every
    simulation is kicked every 5 s. After each join, over ``--window`` s: the real-time factor of every
    simulation (simulated s / wall s), the server's CPU (% of one core, all its threads) and resident memory.
-   The ramp stops at the first count where a simulation falls below RTF 0.99; the answer is the count before.
+   The ramp stops at the first count where a simulation falls below RTF 0.99 in two windows running; the
+   answer is the count before.
    ``--profile`` samples the server with py-spy at the largest count that kept real time (where the time goes).
 2. ``student``: one ``rns-viz serve`` as jupyter-server-proxy starts it for a student (one simulation), its
    CPU and memory with nobody watching (idle) and with one page watching and kicking (active); and, if
@@ -190,6 +191,9 @@ def bench_visitors(max_count: int, seconds: float, want_profile: bool) -> None:
                 time.sleep(0.2)
             time.sleep(SETTLE_S)
             w = window(child, seconds)
+            if min(w["rtfs"]) < 0.99:  # once more: on a shared machine a burst of other work is no verdict
+                print(f"    (min RTF {min(w['rtfs']):.3f} at load {load()}: measured again)", flush=True)
+                w = window(child, seconds)
             low, mid = min(w["rtfs"]), statistics.median(w["rtfs"])
             per_mb = (w["rss_mb"] - base["rss_mb"]) / n
             print(
