@@ -40,16 +40,10 @@ IDLE_PAUSE_S = 5 * 60.0  # wall s without input before a visitor's simulation is
 IDLE_CLOSE_S = 20 * 60.0  # wall s without input before it is closed and its place freed
 IDLE_CHECK_S = 5.0  # wall s between looks for idle visitors
 # What a person's hand sends: any GUI change, a drag or click in the scene, a camera move.
+INPUT_NAMES = "GuiUpdateMessage TransformControlsUpdateMessage TransformControlsDragStartMessage SceneNodeClickMessage"
 INPUT_MESSAGES: tuple[type, ...] = tuple(
     kind
-    for name in (
-        "GuiUpdateMessage",
-        "TransformControlsUpdateMessage",
-        "TransformControlsDragStartMessage",
-        "SceneNodeClickMessage",
-        "SceneNodeDragMessage",
-        "ViewerCameraMessage",
-    )
+    for name in (*INPUT_NAMES.split(), "SceneNodeDragMessage", "ViewerCameraMessage")
     if isinstance(kind := getattr(viser_messages, name, None), type)
 )
 FULL_TEXT = (
@@ -114,6 +108,7 @@ class Classroom:
         self.visitors: dict[int, Visitor] = {}
         self.waiting: list[int] = []  # pages without a place, in order of arrival
         self._guard = threading.RLock()
+        self._switching = threading.Lock()
         self._stop = threading.Event()
         self._watcher = threading.Thread(target=self._watch_idle, name="rns-idle", daemon=True)
         for kind in INPUT_MESSAGES:
@@ -256,6 +251,10 @@ class Classroom:
     # ---------------------------------------------------------------- the presenter
     def show(self, presenter: int | None) -> None:
         """Show the simulation of ``presenter`` (a client id) on every other page, or nobody's (None)."""
+        with self._switching:  # one switch at a time: a double click must not build two apps on a page
+            self._switch(presenter)
+
+    def _switch(self, presenter: int | None) -> None:
         with self._guard:
             if presenter is not None and not (presenter in self.visitors and self.visitors[presenter].presenter):
                 return
