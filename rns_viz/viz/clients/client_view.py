@@ -2,7 +2,8 @@
 client alone.
 
 The app (:class:`~rns_viz.viz.server.app.RnsApp`) uses a server's ``gui`` and ``scene``, ``atomic()``,
-``get_clients()``, ``initial_camera``, ``get_port()``, ``stop()`` and the connect / disconnect callbacks.
+``get_clients()``, ``initial_camera``, ``get_port()``, ``stop()``, the connect / disconnect callbacks and
+the gate that paces a page's stream (here: the client's own stream, rns_viz.viz.server.page_pacing).
 :class:`ClientView` answers each for one :class:`viser.ClientHandle`: ``gui`` and ``scene`` are the
 client's own (viser's per-client scope: what is added there reaches no other page), ``get_clients()``
 lists this client while it is connected, the initial camera is the client's camera, and the connect
@@ -19,12 +20,16 @@ from contextlib import AbstractContextManager
 import viser
 
 ClientCallback = Callable[[viser.ClientHandle], None]
+PaceGate = Callable[[Callable[[int, float], float], Callable[[int], None]], bool]
 
 
 class ClientView:
     """The part of a :class:`viser.ViserServer` one client sees."""
 
-    def __init__(self, server: viser.ViserServer, client: viser.ClientHandle) -> None:
+    def __init__(
+        self, server: viser.ViserServer, client: viser.ClientHandle, pace_gate: PaceGate | None = None
+    ) -> None:
+        """``pace_gate``: attaches an app's pace to this client's own stream (False: it cannot be paced)."""
         self.shared = server  # the server every visitor shares (it outlives this view)
         self.client = client
         self.gui = client.gui
@@ -33,6 +38,11 @@ class ClientView:
         self._guard = threading.Lock()
         self._connected = True
         self._left_callbacks: list[ClientCallback] = []
+        self._pace_gate = pace_gate
+
+    def attach_pace_gate(self, wait_s: Callable[[int, float], float], sent: Callable[[int], None]) -> bool:
+        """Pace this client's own stream (rns_viz.viz.server.page_pacing asks; False: it cannot be)."""
+        return self._pace_gate is not None and self._pace_gate(wait_s, sent)
 
     @property
     def connected(self) -> bool:

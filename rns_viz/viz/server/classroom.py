@@ -24,7 +24,6 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from contextlib import suppress
-from dataclasses import dataclass, field
 from typing import Any, cast
 
 import viser
@@ -33,7 +32,9 @@ import viser._messages as viser_messages
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.clients.client_view import ClientView
 from rns_viz.viz.server.app import RnsApp
+from rns_viz.viz.server.page_pacing import LateGate, gate_buffer
 from rns_viz.viz.server.presenter import WatchedSession, add_show_switch, add_watching_line, is_loopback, refuser
+from rns_viz.viz.server.visitor import CLOSED_TEXT, FULL_TEXT, Visitor
 
 VISITORS_PER_CORE = 3  # simulations per CPU core that keep real time (benchmarks/bench_visitors.py)
 IDLE_PAUSE_S = 5 * 60.0  # wall s without input before a visitor's simulation is paused
@@ -46,38 +47,11 @@ INPUT_MESSAGES: tuple[type, ...] = tuple(
     for name in (*INPUT_NAMES.split(), "SceneNodeDragMessage", "ViewerCameraMessage")
     if isinstance(kind := getattr(viser_messages, name, None), type)
 )
-FULL_TEXT = (
-    "**This class is full.** All {cap} simulations are in use. This page waits and starts yours as soon as "
-    "one is free; there is no need to reload. You are number {place} in the queue."
-)
-CLOSED_TEXT = (
-    "**Your simulation was closed** after {minutes:g} minutes without input, to make room for others. "
-    "Press the button to start a new one."
-)
 
 
 def default_visitor_cap(cores: int | None = None) -> int:
     """How many simulations this machine runs at once in real time: VISITORS_PER_CORE per core."""
     return max(1, VISITORS_PER_CORE * (cores or os.cpu_count() or 1))
-
-
-@dataclass
-class Visitor:
-    """One page: its view of the server and, while it holds a place, its session and the app it shows (on
-    its own session, or on the presenter's while the presenter shows theirs)."""
-
-    view: ClientView
-    presenter: bool = False  # may show its simulation on every other page
-    session: Session | None = None
-    app: RnsApp | None = None
-    watching: bool = False  # the app shows the presenter's session
-    resume_after_watch: bool = False  # the own session ran when watching began
-    extra: Any = None  # the presenter's switch, or the watcher's line, in the page's panel
-    last_input: float = field(default_factory=time.monotonic)
-    opening: bool = False  # its app is being built (it holds a place already)
-    idle_paused: bool = False  # paused by the idle rule (the next input resumes it)
-    notice: Any = None  # the waiting / closed message in the page's panel
-    start_again: Any = None  # the button under a "closed" message
 
 
 class Classroom:
@@ -111,6 +85,8 @@ class Classroom:
         self._switching = threading.Lock()
         self._stop = threading.Event()
         self._watcher = threading.Thread(target=self._watch_idle, name="rns-idle", daemon=True)
+        self._gates: dict[int, LateGate] = {}  # each page's own stream, paced by its app (a slow page gets less)
+        server._websock_server.on_client_connect(self._gate_stream)  # before the page's stream starts
         for kind in INPUT_MESSAGES:
             server._websock_server.register_handler(kind, self._input)  # every page's input, by client id
         server.on_client_connect(self._joined)
@@ -148,6 +124,13 @@ class Classroom:
         return self.server.get_port()
 
     # ---------------------------------------------------------------- arrivals and departures
+    def _gate_stream(self, connection: Any) -> None:
+        """Put a gate on a new page's own stream (its app's scene, panel and plots), for its app to pace."""
+        gate = LateGate()
+        with suppress(AttributeError):  # a viser without per-client buffers: that page goes unpaced
+            if gate_buffer(connection.get_message_buffer(), gate.wait_s, gate.sent):
+                self._gates[connection.client_id] = gate
+
     def _joined(self, client: viser.ClientHandle) -> None:
         visitor = Visitor(ClientView(self.server, client), presenter=self.is_presenter(client.client_id))
         with self._guard:
@@ -160,6 +143,7 @@ class Classroom:
             visitor = self.visitors.pop(client.client_id, None)
             with suppress(ValueError):
                 self.waiting.remove(client.client_id)
+            self._gates.pop(client.client_id, None)
         if visitor is not None:
             visitor.view.client_left()  # the app's own disconnect handling (a drag ended, control passed on)
             self._close(visitor)
@@ -213,9 +197,11 @@ class Classroom:
                 visitor.resume_after_watch = not visitor.session.snapshot().paused
                 visitor.session.pause()
             session = WatchedSession(watched, refuser(client))
-        visitor.view = ClientView(self.server, client)  # a fresh view: the old app's callbacks stay with the old
+        gate = self._gates.get(client.client_id)
+        # a fresh view for each app (the old app's callbacks stay with the old one)
+        visitor.view = ClientView(self.server, client, None if gate is None else gate.attach)
         view = cast(viser.ViserServer, visitor.view)  # the app uses only what ClientView provides
-        app = RnsApp(view, session, password=None, models=self.models, pace=False).start()
+        app = RnsApp(view, session, password=None, models=self.models, pace=gate is not None).start()
         with suppress(Exception):  # the page may have gone
             if watched is not None:
                 visitor.extra = add_watching_line(client)
