@@ -41,6 +41,7 @@ from benchmarks.bench_app import load  # noqa: E402 (the load average, as the ot
 
 KICK_EVERY_S = 5.0  # wall s between kicks of each simulation
 SETTLE_S = 3.0  # wall s after a join before measuring (the new page's scene and GUI are sent)
+SAMPLES_PER_S = 100  # py-spy's sampling rate
 
 
 def rss_mb(pid: int | str = "self") -> float:
@@ -149,7 +150,8 @@ def profile(pid: int, seconds: float) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "profile.txt"
         cmd = ["py-spy", "record", "--pid", str(pid), "--duration", str(int(seconds)), "--format", "raw"]
-        cmd += ["--threads", "--gil"]  # samples of the thread holding the interpreter lock: where CPU time goes
+        # samples of the thread holding the interpreter lock: where the Python time goes
+        cmd += ["--threads", "--gil", "--rate", str(SAMPLES_PER_S)]
         result = subprocess.run([*cmd, "--output", str(out), "--nonblocking"], capture_output=True, text=True)
         if result.returncode != 0 or not out.exists():
             print(f"  py-spy failed: {result.stderr.strip()[-300:]}")
@@ -165,7 +167,8 @@ def profile(pid: int, seconds: float) -> None:
             by_thread[frames[0]] = by_thread.get(frames[0], 0) + n
             leaf = frames[-1].split(" (")[0] + " (" + frames[-1].rsplit("/", 1)[-1]
             own[leaf] = own.get(leaf, 0) + n
-    print(f"  py-spy, {total} samples: by thread")
+    busy = total / (SAMPLES_PER_S * int(seconds))  # a sample is taken only while a thread holds the lock
+    print(f"  py-spy, {total} samples: the interpreter lock held {100 * busy:.0f} % of the time; by thread")
     for name, n in sorted(by_thread.items(), key=lambda kv: -kv[1])[:6]:
         print(f"    {100 * n / total:5.1f} %  {name[:90]}")
     print("  own time, top 12")
