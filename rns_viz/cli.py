@@ -80,6 +80,24 @@ def _load_model(name: str) -> FsmsModel:
     return FsmsModel.from_file(name) if name.endswith(".toml") else FsmsModel.from_name(name)
 
 
+def _models_in(folder: Path) -> list[str]:
+    """The model keys of the parameter files (``*.toml``) in ``folder`` that read as models; each one that
+    does not is named on stderr and left out (a folder of a student's files must not stop the app)."""
+    if not folder.is_dir():
+        if folder.exists():
+            raise CliError(f"--model-dir {folder}: not a folder")
+        return []
+    keys = []
+    for path in sorted(folder.glob("*.toml")):
+        try:
+            _load_model(str(path))
+        except (ModelFileError, OSError) as exc:
+            print(f"rns-viz: skipping {path}: {exc}", file=sys.stderr)
+            continue
+        keys.append(model_key(str(path)))
+    return keys
+
+
 def _open_for_writing(path: Path):
     try:
         return path.open("w", newline="")
@@ -218,6 +236,8 @@ def cmd_serve(args: argparse.Namespace) -> None:
     models = [model_key(name) for name in args.model or ["trep"]]  # files by absolute path: one key each
     for name in models:  # every file is read and checked now: a bad one is refused before serving
         _load_model(name)
+    if args.model_dir is not None:
+        models += [name for name in _models_in(Path(args.model_dir)) if name not in models]
     model = models[0]
     if args.lesson is not None:
         from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
@@ -228,7 +248,19 @@ def cmd_serve(args: argparse.Namespace) -> None:
         if args.lesson > count:
             raise CliError(f"{model} has lessons 1 to {count}, not {args.lesson}")
     extra = [name for name in models if name.endswith(".toml")]
-    serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)
+    if args.each_visitor:
+        from rns_viz.viz.server.classroom import serve_classroom
+
+        if args.lesson is not None:
+            raise CliError("--lesson and --each-visitor do not go together: each visitor starts their own lessons")
+        if password is not None:
+            raise CliError(
+                "--password has no use with --each-visitor: every visitor operates their own simulation, and the "
+                "presenter is the page opened on this machine"
+            )
+        serve_classroom(model, args.host, args.port, extra, args.max_visitors, args.idle_minutes)
+        return
+    serve(model, args.host, args.port, password, args.lesson, extra, pause_unwatched=args.pause_unwatched)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -283,10 +315,40 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         help=MODEL_HELP + "; the first is served, every file joins the model dropdown (repeat to add more)",
     )
+    serve.add_argument(
+        "--model-dir",
+        metavar="DIR",
+        default=None,
+        help="every model parameter file (*.toml) in DIR joins the model dropdown (files that do not read are skipped)",
+    )
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
     serve.add_argument("--lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
+    serve.add_argument(
+        "--pause-unwatched",
+        action="store_true",
+        help="pause the simulation while no page is open (one student's app on JupyterHub: little CPU when idle)",
+    )
+    serve.add_argument(
+        "--each-visitor",
+        action="store_true",
+        help="give every browser page its own simulation (a lab room on one machine; see docs/deploy/classroom.md)",
+    )
+    serve.add_argument(
+        "--max-visitors",
+        metavar="N",
+        type=_positive_int,
+        default=None,
+        help="with --each-visitor: simulations at once (default 3 per CPU core); later pages wait for a place",
+    )
+    serve.add_argument(
+        "--idle-minutes",
+        metavar="M",
+        type=_positive_float,
+        default=20.0,
+        help="with --each-visitor: close a simulation after M minutes without input (paused after M/4, at most 5)",
+    )
     serve.set_defaults(func=cmd_serve)
     return parser
 

@@ -96,3 +96,35 @@ def test_malformed_parameter_file(tmp_path: Path) -> None:
     result = run("info", "--model", str(bad))
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "bad.toml: [base] stiffness[0][0]: expected a number, got a string" in result.stderr
+
+
+def test_model_dir_offers_model_files_and_names_the_others(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``serve --model-dir``: a student's folder may hold anything; a model file joins the dropdown, a file that
+    is not one is named on stderr and left out (the app still starts)."""
+    from rns_viz.cli import _models_in
+    from tests.support.app_helpers import user_model
+
+    good = user_model(tmp_path)
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "not-a-model"\n')
+    (tmp_path / "notes.txt").write_text("not a parameter file")
+    assert _models_in(tmp_path) == [str(good.resolve())]
+    assert "pyproject.toml" in capsys.readouterr().err
+    assert _models_in(tmp_path / "absent") == []  # no folder yet: nothing offered, no error
+
+
+def test_jupyter_entry_point_serves_on_loopback_with_the_students_model_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What jupyter-server-proxy is given: a command on loopback at the proxy's port with the model folder,
+    an existing SVG icon for the launcher, and the root redirected to the page (tests/browser runs it)."""
+    from rns_viz.cli import build_parser
+    from rns_viz.jupyter import setup_rns_viz
+
+    monkeypatch.setenv("RNS_VIZ_MODEL_DIR", str(tmp_path))
+    spec = setup_rns_viz()
+    command = spec["command"](port=43210)
+    args = build_parser().parse_args(command[3:])  # after "python -m rns_viz.cli"
+    assert (args.host, args.port, args.model_dir) == ("127.0.0.1", 43210, str(tmp_path))
+    icon = Path(spec["launcher_entry"]["icon_path"])
+    assert icon.suffix == ".svg" and "<svg" in icon.read_text()
+    assert spec["launcher_entry"]["title"] == "rns_viz" and spec["timeout"] >= 30.0

@@ -59,11 +59,14 @@ class RnsApp:
         models: Sequence[str] = (),
         pace: bool = True,
         seat_on_connect: bool = True,
+        pause_unwatched: bool = False,
     ) -> None:
         """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
         presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files
         offered in the model dropdown besides the bundled models;
-        ``pace=False``: every page gets every update however slowly it draws."""
+        ``pace=False``: every page gets every update however slowly it draws; ``pause_unwatched``: the
+        simulation pauses while no page is open and runs on when one comes (one student's app: its CPU
+        is then ~2 % of a core, not ~12 %)."""
         self.server = server
         self.session = session
         self.password = password
@@ -92,6 +95,10 @@ class RnsApp:
         start = session.snapshot()
         self._unwatched_since: tuple[int, float] | None = (start.epoch, start.t)  # (epoch, t) the last client left
         self._visitors = threading.Lock()
+        self.pause_unwatched = pause_unwatched
+        self._paused_unwatched = pause_unwatched  # paused while no page is open (the next page resumes it)
+        if pause_unwatched:
+            session.pause()
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
@@ -181,6 +188,9 @@ class RnsApp:
                 unwatched = snap.t - since[1] if snap.epoch == since[0] else snap.t  # s of simulated time
                 if unwatched > IDLE_RESTART_S:
                     self.session.reset()
+            if self._paused_unwatched:
+                self._paused_unwatched = False
+                self.session.resume()
         self.connections.identify_browser(client)  # last: it waits for the page's answer
 
     def _client_left(self, client: viser.ClientHandle) -> None:
@@ -193,6 +203,9 @@ class RnsApp:
             if self.connections.client_count() == 0:
                 snap = self.session.snapshot()
                 self._unwatched_since = (snap.epoch, snap.t)
+                if self.pause_unwatched and not snap.paused:
+                    self._paused_unwatched = True
+                    self.session.pause()
 
 
 def start_app(
@@ -205,17 +218,26 @@ def start_app(
     lesson: int | None = None,
     models: Sequence[str] = (),
     pace: bool = True,
+    pause_unwatched: bool = False,
 ) -> RnsApp:
     """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
     ``lesson``: start at that lesson (1-based) of the model; ``model`` is a bundled name or a parameter
     file (ModelFileError names the element at fault), ``models`` more files for the model dropdown;
     ``pace=False``: every page gets every update however slowly it draws (for comparisons; see
-    :mod:`rns_viz.viz.server.page_pacing`)."""
+    :mod:`rns_viz.viz.server.page_pacing`); ``pause_unwatched``: see :class:`RnsApp`."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password, models, pace=pace, seat_on_connect=host in LOOPBACK_HOSTS).start()
+        app = RnsApp(
+            server,
+            session,
+            password,
+            models,
+            pace=pace,
+            seat_on_connect=host in LOOPBACK_HOSTS,
+            pause_unwatched=pause_unwatched,
+        ).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:
@@ -236,9 +258,10 @@ def serve(
     password: str | None = None,
     lesson: int | None = None,
     models: Sequence[str] = (),
+    pause_unwatched: bool = False,
 ) -> None:
     """Serve the live app until interrupted (Ctrl+C). Binds 127.0.0.1 unless told otherwise."""
-    app = start_app(model, host, port, password, lesson=lesson, models=models)
+    app = start_app(model, host, port, password, lesson=lesson, models=models, pause_unwatched=pause_unwatched)
     print(f"rns_viz live app: http://{host}:{app.port}  (Ctrl+C to stop)")
     try:
         while True:
