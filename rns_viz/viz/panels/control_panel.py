@@ -115,6 +115,7 @@ class GuiElements:
     model: viser.GuiDropdownHandle
     menu: ModelMenu
     exaggeration: NumberField
+    auto_exaggeration: viser.GuiCheckboxHandle
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
 
@@ -295,8 +296,15 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             max=100.0,
             step=1.0,
             initial_value=defaults.exaggeration,
-            hint="The base deflection is drawn this many times larger than simulated.",
+            hint="The base deflection is drawn this many times larger than simulated (written beside the base). "
+            "Typing a factor fixes it (Auto off).",
             bounded=True,  # only drawn
+        )
+        auto_exaggeration = gui.add_checkbox(
+            "Auto deflection scale",
+            defaults.auto_exaggeration,
+            hint="The factor follows the motion: the recent largest base deflection is drawn at about a tenth "
+            "of the arm's reach (1-2-5 steps up to ×10000), so µm and mm both show.",
         )
         speed = gui.add_dropdown(
             "Speed",
@@ -346,6 +354,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         model=model_dd,
         menu=menu,
         exaggeration=exaggeration,
+        auto_exaggeration=auto_exaggeration,
         shadow=shadow,
         download=download,
     )
