@@ -195,3 +195,17 @@ def test_framing_puts_every_corner_inside_the_stated_fraction() -> None:
         y = (rel @ up) / (depth * np.tan(0.5))
         assert np.all(np.abs(x) <= 0.7 + 1e-9) and np.all(np.abs(y) <= 0.7 + 1e-9)
         assert max(np.abs(x).max(), np.abs(y).max()) > 0.5  # and fills a good part of the view
+
+
+def test_every_preset_and_lesson_says_what_to_look_at() -> None:
+    """Each preset's panel text and each lesson's text carries a 'Look at:' line of its own."""
+    from rns_viz.live.teaching.lessons import LESSON_LIBRARY
+    from rns_viz.scenarios import LIVE_SCENARIOS
+    from rns_viz.viz.panels.control_panel import preset_description
+
+    for name, preset in LIVE_SCENARIOS.items():
+        assert len(preset.look) > 20, name
+        assert f"**Look at:** {preset.look}" in preset_description(name)
+    for name, lesson in LESSON_LIBRARY.items():
+        assert len(lesson.look) > 20, name
+    assert len({p.look for p in LIVE_SCENARIOS.values()}) >= 18  # their own words, not one line for all

@@ -64,7 +64,7 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                 inside, span = arm_on_screen(page, joints)
                 assert inside and span >= MIN_SPAN, (w, h, span)
                 if w >= 1366:  # the base-deflection chart: in the viewport, no scrolling
-                    chart = page.get_by_text("Base deflection").first
+                    chart = page.get_by_text("Base vibration x_b").first
                     box = chart.bounding_box()
                     assert box is not None and box["y"] >= 0 and box["y"] + box["height"] <= h, box
                     assert box["x"] >= 0 and box["x"] + box["width"] <= w

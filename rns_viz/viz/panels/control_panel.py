@@ -31,7 +31,7 @@ SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     (
         "g_b",
-        "g_b (1/s)",
+        "Base damping g_b (1/s)",
         0.0,
         50.0,
         0.1,
@@ -39,7 +39,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "g_m",
-        "g_m (1/s)",
+        "Joint hold g_m (1/s)",
         0.0,
         100.0,
         0.1,
@@ -48,7 +48,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "G_p",
-        "G_p (1/s²)",
+        "Hand pull G_p (1/s²)",
         0.0,
         2000.0,
         1.0,
@@ -56,7 +56,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "G_d",
-        "G_d (1/s)",
+        "Hand damping G_d (1/s)",
         0.0,
         500.0,
         1.0,
@@ -64,7 +64,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "k_p",
-        "k_p (1/s²)",
+        "Joint stiffness k_p (1/s²)",
         0.0,
         2000.0,
         1.0,
@@ -72,7 +72,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "k_d",
-        "k_d (1/s)",
+        "Joint damping k_d (1/s)",
         0.0,
         200.0,
         0.5,
@@ -171,7 +171,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         kick_peak = NumberField(
             gui,
-            "Kick peak (N)",
+            "Kick strength, peak force (N)",
             min=-defaults.kick_range_N,
             max=defaults.kick_range_N,
             step=0.1,
@@ -216,7 +216,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         sigma = NumberField(
             gui,
-            "Path ∫ū dt (1/(kg·m))",
+            "Position along the path ∫ū dt (1/(kg·m))",
             min=-80.0,
             max=80.0,
             step=0.1,
@@ -248,7 +248,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         ubar_speed = NumberField(
             gui,
-            "ū speed (1/(kg·m·s))",
+            "Speed along the path ū (1/(kg·m·s))",
             min=1.0,
             max=100.0,
             step=1.0,
@@ -291,7 +291,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         exaggeration = NumberField(
             gui,
-            "Deflection drawn ×",
+            "Base deflection drawn ×",
             min=1.0,
             max=100.0,
             step=1.0,
@@ -313,9 +313,9 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="Simulated seconds per wall-clock second.",
         )
         shadow = gui.add_checkbox(
-            "Shadow run",
+            "Ghost run (suppression the other way)",
             True,
-            hint="A second simulation with the same inputs and kicks and suppression the other way: "
+            hint="The shadow run: a second simulation with the same inputs and kicks and suppression the other way: "
             "the blue ghost and the second plot lines.",
         )
     download = gui.add_button(
@@ -385,4 +385,5 @@ def show_presets(presets: dict[str, viser.GuiButtonGroupHandle], menu: ModelMenu
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**{name}**: {LIVE_SCENARIOS[name].description}. Reset restarts it."
+    preset = LIVE_SCENARIOS[name]
+    return f"**{name}**: {preset.description}.\n\n**Look at:** {preset.look} Reset restarts it."

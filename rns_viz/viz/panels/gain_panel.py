@@ -55,7 +55,7 @@ def _locus_plot(gui: viser.GuiApi, title: str) -> viser.GuiUplotHandle:
         series=tuple(series),
         title=title,
         scales={"x": {"time": False, "auto": False, "range": (-1.0, 0.1)}, "y": {"auto": False, "range": (-1.0, 1.0)}},
-        axes=({"label": "Re λ (1/s)"}, {"label": "Im λ (1/s)", "size": 60}),
+        axes=({"label": "decay rate Re λ (1/s)"}, {"label": "ringing Im λ (1/s)", "size": 60}),
         legend={"show": True, "live": False},
         cursor={"show": False},
         aspect=1.3,
