@@ -228,7 +228,15 @@ def cmd_serve(args: argparse.Namespace) -> None:
         if args.lesson > count:
             raise CliError(f"{model} has lessons 1 to {count}, not {args.lesson}")
     extra = [name for name in models if name.endswith(".toml")]
-    serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)
+    serve(
+        model=model,
+        host=args.host,
+        port=args.port,
+        password=password,
+        lesson=args.lesson,
+        models=extra,
+        present=args.present,
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -287,6 +295,11 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
     serve.add_argument("--lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
+    serve.add_argument(
+        "--present",
+        action="store_true",
+        help="for a projector: larger text, wider plots, fewer folders (no gain explorer, replay, gains, log)",
+    )
     serve.set_defaults(func=cmd_serve)
     return parser
 

@@ -107,6 +107,7 @@ class GuiElements:
     target_folder: viser.GuiFolderHandle
     target_text: viser.GuiMarkdownHandle
     target_speed: NumberField
+    gains_folder: viser.GuiFolderHandle
     law: viser.GuiDropdownHandle
     gains: dict[str, NumberField]
     presets: dict[str, viser.GuiButtonGroupHandle]  # model key -> its presets, in the menu's order
@@ -269,7 +270,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="Speed limit of the smoothed target.",
             bounded=False,
         )
-    with gui.add_folder("Control law and gains", expand_by_default=False):
+    with gui.add_folder("Control law and gains", expand_by_default=False) as gains_folder:
         law = gui.add_dropdown(
             "Law",
             tuple(LAW_LABELS[k] for k in LAW_KINDS),
@@ -346,6 +347,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         target_folder=target_folder,
         target_text=target_text,
         target_speed=target_speed,
+        gains_folder=gains_folder,
         law=law,
         gains=gains,
         presets=presets,

@@ -86,7 +86,9 @@ class GainExplorerView:
         self.server, self.session, self.gui = server, session, gui
         self.controls, self.connections = controls, connections
         g = server.gui
-        with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
+        with g.add_folder(
+            "Gain explorer", order=gui.download.order - 0.5, expand_by_default=True
+        ) as self.folder:  # above Download
             g.add_markdown(
                 "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
                 "(g_b, g_m) setting, coloured by "
