@@ -176,6 +176,6 @@ BOOM7_LESSONS = (
         "shake the boom.",
         LessonStart("boom7#S=111000", "acceleration", True),
         ForcesStayZero,
-        look="the arm's push on the base (coupling momentum): its force rows stay near zero, the moment rows move.",
+        look="the momentum handed to the base (L): its force rows stay near zero, the moment rows move.",
     ),
 )

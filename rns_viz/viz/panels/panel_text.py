@@ -94,7 +94,7 @@ def readouts_html(snap: Snapshot) -> str:
             "the joint direction that pushes the base not at all (orange arrow: the hand's way), Eq. (27)",
         ),
         (
-            "arm's push on the base L = H<sub>bm</sub>θ̇",
+            "momentum handed to the base L = H<sub>bm</sub>θ̇",
             si(r.L, "N·s", 1e-9, True),
             "momentum the joints hand to the base (purple arrow), Eq. (8); 1 N·s = 1 kg·m/s",
         ),
@@ -138,7 +138,7 @@ def dual_rows(snap: Snapshot) -> list[tuple[str, str, str]]:
             "how freely the task arm's hand moves; near 0 it is stretched out or folded",
         ),
         (
-            "both arms' push L = S H<sub>bm</sub>θ̇",
+            "momentum both arms hand over L = S H<sub>bm</sub>θ̇",
             si(r.L, "N·s", 1e-9, True),
             "total momentum both arms hand to the base (purple arrow), Eq. (8): the compensator keeps it 0",
         ),

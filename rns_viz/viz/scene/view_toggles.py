@@ -51,7 +51,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
     ),
     (
         "coupling",
-        "Arm's push on the base: momentum L (kg·m/s)",
+        "Momentum handed to the base L (kg·m/s)",
         True,
         "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8). "
         "Zero on a reactionless path.",
