@@ -110,3 +110,26 @@ def test_the_factor_written_beside_the_base_is_the_factor_drawn(trep_app: RnsApp
         app.session.advance(FRAME_STEPS * 1e-3)
         r._frame(time.perf_counter())
         assert r.scene.exaggeration == 20.0 and r.scene.base_label.text == base_label(20.0)
+
+
+def test_a_factor_the_operator_drags_fixes_it_and_a_watchers_is_refused(trep_app: RnsApp) -> None:
+    """Dragging *Base deflection drawn ×* is a fixed factor: auto goes off and the base is drawn with it; a
+    watcher's drag changes neither."""
+    from tests.support.browser import wait_for_clients, wait_until
+    from tests.support.protocol_client import ProtocolClient, gui_uuid
+
+    app, g = trep_app, trep_app.gui
+    operator = ProtocolClient(app.port, decode=True)
+    wait_for_clients(app, 1, "the operator")
+    watcher = ProtocolClient(app.port, decode=True)
+    wait_for_clients(app, 2, "the watcher")
+    assert g.auto_exaggeration.value
+    watcher.set_value(gui_uuid(g.exaggeration.slider), 40.0)
+    wait_until(lambda: any(t == "View only" for t, _ in watcher.notifications), 10.0, "the watcher told")
+    assert app.good(g.auto_exaggeration) and app.good(g.exaggeration) != 40.0
+    operator.set_value(gui_uuid(g.exaggeration.slider), 30.0)
+    wait_until(lambda: not app.good(g.auto_exaggeration), 10.0, "auto off")
+    app.session.kick(1.0)
+    app.session.advance(0.5)
+    wait_until(lambda: app.scene.exaggeration == 30.0, 10.0, "the base drawn ×30")
+    assert app.scene.base_label.text == base_label(30.0) and not g.auto_exaggeration.value
