@@ -55,7 +55,7 @@ class Ghost:
         hand = model.pin_model.frames[model.ee_frame_id]
         self.label = server.scene.add_label(
             f"{self.robot.node_names[hand.parentJoint]}/ghost_label",
-            "shadow run",
+            "ghost",
             anchor="top-left",
             position=tuple(float(v) for v in hand.placement.translation),
         )
