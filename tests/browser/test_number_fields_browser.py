@@ -81,6 +81,6 @@ def test_typed_gains_are_applied_exactly_or_refused_with_a_message(app: RnsApp) 
             wait_until(lambda v=value: box.input_value() == shown(v), 10.0, f"the box to show {value}")
             assert told[before:] == [], told[before:]
         # A value typed into g_m far beyond its slider's range is the number typed.
-        type_keys(page, box_of(page, "g_m (1/s)"), "2.5e3")
+        type_keys(page, box_of(page, "Joint hold g_m (1/s)"), "2.5e3")
         wait_until(lambda: gains().g_m == 2500.0, 10.0, "g_m = 2500 from '2.5e3'")
         assert app.gui.gains["g_m"].max >= 2500.0
