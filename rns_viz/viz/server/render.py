@@ -31,12 +31,12 @@ from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
 from rns_viz.viz.panels.model_words import kick_hint, target_text
 from rns_viz.viz.panels.panel_text import readouts_html, status_html
-from rns_viz.viz.scene.auto_scale import AutoExaggeration
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles
+from rns_viz.viz.server.drawn_factor import DrawnFactor
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
@@ -97,7 +97,7 @@ class Renderer:
         spatial = len(self.model.task_rows) == 3  # the handle moves in 3-D and gives (x, y, z)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
         self._reach = self.model.arm_reach
-        self.auto = AutoExaggeration(self._reach, self.model.base_rotational, defaults_for(self.model).exaggeration)
+        self.factor = DrawnFactor(self.model, self.gui, self.controls, self.view)  # the base's drawn factor
         self.teach = TeachScene(self.server, self.model, self.scene)
         self.rank = RankScene(self.server, self.model, self.scene.style)
         self.kind = operator_class(self.model)  # what the operator drives: the panel's folders, laws and words
@@ -184,7 +184,7 @@ class Renderer:
         if snap.epoch != seen.epoch or jumped:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
-        exaggeration = self.exaggeration(snap)
+        exaggeration = self.factor.for_frame(snap)
         self._draw_state(snap, exaggeration)
         q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
         self.teach.draw(snap, q_shadow, exaggeration, self.view)
@@ -226,21 +226,8 @@ class Renderer:
             seen.overlay_version = -1  # redrawn with or without the family
         self.explorer.show(view.on("gain_map"))
 
-    def exaggeration(self, snap: Snapshot) -> float:
-        """The factor this frame draws the base deflection with: the auto scale's (shown in the panel's box
-        too), or the operator's fixed one."""
-        if not self.controls.good(self.gui.auto_exaggeration):
-            return float(self.controls.good(self.gui.exaggeration))
-        m = self.model.m
-        shadow = None if snap.q_shadow is None or not self.view.on("ghost") else snap.q_shadow[:m]
-        factor = self.auto.observe(snap.t, (snap.q[:m], shadow))
-        if factor != self.controls.good(self.gui.exaggeration) and not self.gui.exaggeration.typing():
-            self.controls.show(self.gui.exaggeration, factor)
-        return factor
-
     def _draw_state(self, snap: Snapshot, exaggeration: float) -> None:
-        """The arm, the base and the reaction arrow, when what a viewer sees changed (the base's label
-        writes the factor the scene draws with)."""
+        """The arm, the base and the reaction arrow (and the base label's factor), when what a viewer sees changed."""
         seen = self._seen
         q = self._drawn(snap.q, exaggeration) if np.all(np.isfinite(snap.q)) else seen.q
         if q is not None and (not np.array_equal(q, seen.q) or exaggeration != seen.exaggeration):
