@@ -260,7 +260,16 @@ def cmd_serve(args: argparse.Namespace) -> None:
             )
         serve_classroom(model, args.host, args.port, extra, args.max_visitors, args.idle_minutes)
         return
-    serve(model, args.host, args.port, password, args.lesson, extra, pause_unwatched=args.pause_unwatched)
+    serve(
+        model=model,
+        host=args.host,
+        port=args.port,
+        password=password,
+        lesson=args.lesson,
+        models=extra,
+        present=args.present,
+        pause_unwatched=args.pause_unwatched,
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -348,6 +357,11 @@ def build_parser() -> argparse.ArgumentParser:
         type=_positive_float,
         default=20.0,
         help="with --each-visitor: close a simulation after M minutes without input (paused after M/4, at most 5)",
+    )
+    serve.add_argument(
+        "--present",
+        action="store_true",
+        help="for a projector: larger text, wider plots, fewer folders (no gain explorer, replay, gains, log)",
     )
     serve.set_defaults(func=cmd_serve)
     return parser

@@ -26,7 +26,8 @@ class ModelDefaults:
     kick_duration_s: float  # half-sine duration of a kick
     kick_range_N: float  # the kick slider's half range
     kick_axis: int  # the base coordinate a kick pushes along first (the panel's choice)
-    exaggeration: float  # drawn deflection factor
+    exaggeration: float  # drawn deflection factor (fixed; with auto on: the first one drawn)
+    auto_exaggeration: bool  # the factor follows the motion (rns_viz.viz.scene.auto_scale)
     target_speed_m_s: float  # speed limit of the smoothed end-effector target
     # what the scene shows at first (rns_viz.param_file.Overlay): only what a first look needs; the rest is a
     # tick away in *Show in the scene*, and lessons choose their own
@@ -37,6 +38,7 @@ class ModelDefaults:
 
 
 FALLBACK_GAINS = Gains(g_b=10.0, g_m=1.0)
+MANUAL_EXAGGERATION = 10.0  # the fixed factor a file with exaggeration = "auto" starts the box with
 # m: a kick about a rotational base coordinate is the moment of the kick's force at this lever arm
 # (boom7: the slider's 20 N give 2 N m). A moment equal to the force in N would be a lever of 1 m, and
 # 5 N m about the boom's z axis asks the suppressing arm to spin at over 100 rad/s (the run stops).
@@ -65,7 +67,8 @@ def defaults_from(app: AppTable, base_joints: tuple[str, ...], where: str) -> Mo
         kick_duration_s=app.kick_duration_s,
         kick_range_N=app.kick_range_N,
         kick_axis=0 if app.kick_axis is None else base_joints.index(app.kick_axis),
-        exaggeration=app.scene.exaggeration,
+        exaggeration=MANUAL_EXAGGERATION if app.scene.exaggeration == "auto" else app.scene.exaggeration,
+        auto_exaggeration=app.scene.exaggeration == "auto",
         target_speed_m_s=app.target_speed_m_per_s,
         shown=frozenset(app.scene.shown),
     )

@@ -137,7 +137,8 @@ BaseDrawing = DoubleBeamDrawing | CartSpringDrawing | BoomDrawing | NoDrawing
 class SceneTable(Table):
     """[app.scene]: how the model is drawn; a key left out is scaled from the arm's reach."""
 
-    exaggeration: Annotated[float, msgspec.Meta(ge=1.0, le=100.0)] = 10.0  # drawn deflection factor
+    # drawn deflection factor: "auto" (chosen from the recent motion, rns_viz.viz.scene.auto_scale) or fixed
+    exaggeration: Annotated[float, msgspec.Meta(ge=1.0, le=100.0)] | Literal["auto"] = "auto"
     shown: frozenset[Overlay] = frozenset({"ghost", "reaction", "trail", "labels"})  # overlays drawn at first
     base: BaseDrawing | None = None  # default: a boom for a 6-coordinate base that turns, else none
     camera_position_m: Vec3 | None = None

@@ -154,6 +154,7 @@ def test_a_model_file_with_its_own_app_table_is_offered_with_its_label_presets_l
         assert (st.model, st.law, st.gains.g_b, st.gains.g_m, st.target_speed) == (key, "acceleration", 7.0, 3.0, 0.3)
         wait_until(lambda: app.model_name == key, 20.0, "the scene of the file's model")
         assert (g.kick_peak.value, g.kick_peak.max, g.exaggeration.value) == (1.5, 8.0, 25.0)
+        assert not g.auto_exaggeration.value  # a number in the file: a fixed factor
         assert g.law.value == LAW_LABELS["acceleration"] and g.gains["g_b"].value == 7.0
         style = app.renderer.scene.style
         assert style.camera_position == (1.0, 2.0, 3.0) and style.base.spacing == 0.12  # type: ignore[union-attr]

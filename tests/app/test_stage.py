@@ -195,3 +195,42 @@ def test_framing_puts_every_corner_inside_the_stated_fraction() -> None:
         y = (rel @ up) / (depth * np.tan(0.5))
         assert np.all(np.abs(x) <= 0.7 + 1e-9) and np.all(np.abs(y) <= 0.7 + 1e-9)
         assert max(np.abs(x).max(), np.abs(y).max()) > 0.5  # and fills a good part of the view
+
+
+def test_every_preset_and_lesson_says_what_to_look_at() -> None:
+    """Each preset's panel text and each lesson's text carries a 'Look at:' line of its own."""
+    from rns_viz.live.teaching.lessons import LESSON_LIBRARY
+    from rns_viz.scenarios import LIVE_SCENARIOS
+    from rns_viz.viz.panels.control_panel import preset_description
+
+    for name, preset in LIVE_SCENARIOS.items():
+        assert len(preset.look) > 20, name
+        assert f"**Look at:** {preset.look}" in preset_description(name)
+    for name, lesson in LESSON_LIBRARY.items():
+        assert len(lesson.look) > 20, name
+    assert len({p.look for p in LIVE_SCENARIOS.values()}) >= 18  # their own words, not one line for all
+
+
+def test_present_option_reaches_the_app_and_makes_the_projector_screen(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``rns-viz serve --present``: the CLI passes it on; the app hides the folders a demonstration does not
+    need, widens the docked plots and raises the page's text size. Without it nothing is hidden."""
+    import rns_viz.viz.server.app as app_module
+    from rns_viz import cli
+    from rns_viz.viz.panels import presentation
+
+    calls: list[dict[str, object]] = []
+    monkeypatch.setattr(app_module, "serve", lambda **kw: calls.append(kw))
+    assert cli.main(["serve", "--present", "--port", "0"]) == 0 and cli.main(["serve", "--port", "0"]) == 0
+    assert [c["present"] for c in calls] == [True, False]
+
+    for present in (True, False):
+        app = start_app("trep", port=0, realtime=False, verbose=False, present=present)
+        try:
+            g = app.gui
+            folders = (app.renderer.explorer.folder, app.replay.folder, g.gains_folder, g.download)
+            assert [f.visible for f in folders] == [not present] * 4
+            style = app.present_style
+            assert (style.content if style is not None else None) == (presentation.PRESENT_CSS if present else None)
+            assert g.plots_panel.visible and g.readouts.visible and g.kick.visible  # what a demo needs stays
+        finally:
+            app.stop()

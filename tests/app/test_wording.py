@@ -41,12 +41,12 @@ def app() -> Iterator[RnsApp]:
 
 def controls(app: RnsApp) -> dict[str, list[Any]]:
     """Every name a person can find in the panel -> the controls of that name: labels of buttons, boxes,
-    dropdowns and folders (also without a trailing parenthesis), and the options of button groups."""
+    dropdowns, folders and tabs (also without a trailing parenthesis), and the options of button groups."""
     gui = app.server.gui
     names: dict[str, list[Any]] = {}
     handles = [*gui._gui_input_handle_from_uuid.values(), *gui._container_handle_from_uuid.values()]  # (viser's)
     for handle in handles:
-        label = getattr(handle, "label", None)
+        label = getattr(handle, "label", None) or getattr(handle, "_label", None)  # a tab's is private (viser's)
         for name in (label, re.sub(r" \([^()]*\)$", "", label or "")):
             if name:
                 names.setdefault(name, []).append(handle)

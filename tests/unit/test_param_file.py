@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rns_viz.defaults import FALLBACK_GAINS, defaults_for
+from rns_viz.defaults import FALLBACK_GAINS, MANUAL_EXAGGERATION, defaults_for
 from rns_viz.live.teaching.lessons import lessons_for
 from rns_viz.model import FsmsModel
 from rns_viz.param_file import AppTable, SceneTable
@@ -165,7 +165,11 @@ def test_a_file_without_app_gets_generic_defaults(tmp_path: Path) -> None:
         0,
     )
     assert d.gains == {} and d.gains_for("velocity") == FALLBACK_GAINS
-    assert (d.exaggeration, d.target_speed_m_s) == (generic.scene.exaggeration, generic.target_speed_m_per_s)
+    assert (d.auto_exaggeration, d.target_speed_m_s) == (
+        generic.scene.exaggeration == "auto",
+        generic.target_speed_m_per_s,
+    )
+    assert d.auto_exaggeration and d.exaggeration == MANUAL_EXAGGERATION
     model = FsmsModel.from_file(path)
     style = style_for(model)
     reach = model.arm_reach

@@ -94,6 +94,7 @@ class LessonStatus:
     task: str
     done: bool
     progress: str  # what is measured now
+    look: str = ""  # what to watch on screen
 
 
 @dataclass(frozen=True)

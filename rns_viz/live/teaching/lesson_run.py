@@ -42,6 +42,7 @@ class LessonRun:
             equation=lesson.equation,
             text=lesson.text,
             task=lesson.task,
+            look=lesson.look,
             done=progress.done if progress is not None else False,
             progress=progress.message if progress is not None else "",
         )

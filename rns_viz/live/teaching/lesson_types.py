@@ -103,3 +103,4 @@ class Lesson:
     task: str  # what the student does
     start: LessonStart
     check: Callable[[FsmsModel], Check]
+    look: str = ""  # what to watch on screen while doing the task (plain words)

@@ -222,11 +222,12 @@ TREP_LESSONS = (
         "TREP (a two-link arm on a flexible beam) has its arm bolted to the beam's tip: that tip is the **base**. "
         "It moves like a mass on a spring (Eq. (1), the equation of motion), pushed by outside forces and "
         "by the arm's own motion. With the joints held, nothing damps it. Its bend x_b is drawn enlarged "
-        "(x10 by default).",
+        "(the factor is written beside the base).",
         "Press *Kick the base* (a push in newtons, N) and watch the red line in *Live plots*: the base's bend "
         "x_b. The blue line is the shadow run, a copy with suppression on: ignore it until lesson 4.",
         LessonStart("trep", "velocity", False),
         KickAndSwing,
+        look="the red line of the base vibration plot: the swing after a kick does not die out.",
     ),
     Lesson(
         "trep-pushing-motion",
@@ -236,6 +237,7 @@ TREP_LESSONS = (
         "Press *Same end points, joint space*: joint 2 turns alone by half a turn. Watch the base.",
         LessonStart("trep", "velocity", True),
         ShakesTheBase,
+        look="the bent plates and the base vibration plot while joint 2 turns.",
     ),
     Lesson(
         "trep-reactionless-path",
@@ -247,6 +249,7 @@ TREP_LESSONS = (
         "the other side with the base deflection below 0.1 mm.",
         LessonStart("trep", "velocity", True),
         StaysStill,
+        look="the base vibration plot: it stays flat while the arm moves across.",
     ),
     Lesson(
         "trep-suppression",
@@ -257,6 +260,7 @@ TREP_LESSONS = (
         "Press *Kick the base* and compare the arm with its shadow.",
         LessonStart("trep", "velocity", True),
         SuppressedVersusShadow,
+        look="the arm against its blue ghost, and the blue line against the red one in the base vibration plot.",
     ),
     Lesson(
         "trep-weakest-point",
@@ -267,6 +271,7 @@ TREP_LESSONS = (
         "Move along the path to where σ_min(W S H_bm) (readout) is at most 65 % of its start value, and stop there.",
         LessonStart("trep", "velocity", True),
         WeakestPoint,
+        look="the distance to singularity in the readouts, and how fast the joints turn as it shrinks.",
     ),
     Lesson(
         "trep-move-and-suppress",
@@ -277,6 +282,7 @@ TREP_LESSONS = (
         "Press *Start cyclic motion* (the arm goes round the path), then *Kick the base*.",
         LessonStart("trep", "velocity", True),
         CyclicAndKick,
+        look="the base vibration plot: the kick's swing dies out while the arm keeps going round.",
     ),
 )
 
@@ -290,6 +296,7 @@ PLANAR3R_LESSONS = (
         "Drag the target 20 cm or more; the base must stay below 0.1 mm.",
         LessonStart("planar3r", "acceleration", True),
         TrackWithoutReaction,
+        look="the base vibration plot (near zero) while the hand follows the handle.",
     ),
     Lesson(
         "3r-reachable-set",
@@ -300,6 +307,7 @@ PLANAR3R_LESSONS = (
         "Drag the target far outside the lilac dots and watch where the arm goes and where it stops.",
         LessonStart("planar3r", "acceleration", True),
         ClampedTarget,
+        look="where the hand stops: on the edge of the lilac dots, not at the handle.",
     ),
     Lesson(
         "3r-absorb-kick",
@@ -310,6 +318,7 @@ PLANAR3R_LESSONS = (
         "Press *Kick the base* (2 N or more) and watch the arm absorb it.",
         LessonStart("planar3r", "acceleration", True),
         AbsorbKick,
+        look="the elbow swinging while the hand holds its place, and the base vibration dying out.",
     ),
 )
 

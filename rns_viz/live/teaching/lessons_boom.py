@@ -62,7 +62,7 @@ class SixModesSuppressed(Check):
         if math.isnan(self.kick_t):
             return Progress(False, f"Waiting for a kick. Tip now {_six(self.now)}.")
         if not self.shadow_on:
-            return Progress(False, "Tick *Shadow run* to compare with suppression off, and kick again.")
+            return Progress(False, "Tick *Ghost run* to compare with suppression off, and kick again.")
         if self.peak[0] <= self.MIN_PEAK_M:
             return Progress(False, f"The shadow's peak is {self.peak[0] * 1e3:.3f} mm: kick harder (5 N or more).")
         share = 100 * self.left / np.maximum(self.peak, 1e-12)
@@ -151,6 +151,7 @@ BOOM7_LESSONS = (
         "operated boom stops while the shadow rings. Untick *Vibration suppression* to see it the other way.",
         LessonStart("boom7", "acceleration", True),
         SixModesSuppressed,
+        look="the Base coordinates plot: six deflections dying out, while the ghost keeps ringing.",
     ),
     Lesson(
         "boom7-path",
@@ -162,6 +163,7 @@ BOOM7_LESSONS = (
         "below 1 µm and 1 µrad.",
         LessonStart("boom7", "acceleration", True),
         BoomStaysStill,
+        look="the base vibration plot (micrometres) while the hand moves.",
     ),
     Lesson(
         "boom7-forces-only",
@@ -174,5 +176,6 @@ BOOM7_LESSONS = (
         "shake the boom.",
         LessonStart("boom7#S=111000", "acceleration", True),
         ForcesStayZero,
+        look="the momentum handed to the base (L): its force rows stay near zero, the moment rows move.",
     ),
 )

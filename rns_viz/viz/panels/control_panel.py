@@ -31,7 +31,7 @@ SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     (
         "g_b",
-        "g_b (1/s)",
+        "Base damping g_b (1/s)",
         0.0,
         50.0,
         0.1,
@@ -39,7 +39,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "g_m",
-        "g_m (1/s)",
+        "Joint hold g_m (1/s)",
         0.0,
         100.0,
         0.1,
@@ -48,7 +48,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "G_p",
-        "G_p (1/s²)",
+        "Hand pull G_p (1/s²)",
         0.0,
         2000.0,
         1.0,
@@ -56,7 +56,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "G_d",
-        "G_d (1/s)",
+        "Hand damping G_d (1/s)",
         0.0,
         500.0,
         1.0,
@@ -64,7 +64,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "k_p",
-        "k_p (1/s²)",
+        "Joint stiffness k_p (1/s²)",
         0.0,
         2000.0,
         1.0,
@@ -72,7 +72,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "k_d",
-        "k_d (1/s)",
+        "Joint damping k_d (1/s)",
         0.0,
         200.0,
         0.5,
@@ -107,6 +107,7 @@ class GuiElements:
     target_folder: viser.GuiFolderHandle
     target_text: viser.GuiMarkdownHandle
     target_speed: NumberField
+    gains_folder: viser.GuiFolderHandle
     law: viser.GuiDropdownHandle
     gains: dict[str, NumberField]
     presets: dict[str, viser.GuiButtonGroupHandle]  # model key -> its presets, in the menu's order
@@ -115,6 +116,7 @@ class GuiElements:
     model: viser.GuiDropdownHandle
     menu: ModelMenu
     exaggeration: NumberField
+    auto_exaggeration: viser.GuiCheckboxHandle
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
 
@@ -170,7 +172,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         kick_peak = NumberField(
             gui,
-            "Kick peak (N)",
+            "Kick strength, peak force (N)",
             min=-defaults.kick_range_N,
             max=defaults.kick_range_N,
             step=0.1,
@@ -215,7 +217,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         sigma = NumberField(
             gui,
-            "Path ∫ū dt (1/(kg·m))",
+            "Position along the path ∫ū dt (1/(kg·m))",
             min=-80.0,
             max=80.0,
             step=0.1,
@@ -247,7 +249,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         ubar_speed = NumberField(
             gui,
-            "ū speed (1/(kg·m·s))",
+            "Speed along the path ū (1/(kg·m·s))",
             min=1.0,
             max=100.0,
             step=1.0,
@@ -268,7 +270,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="Speed limit of the smoothed target.",
             bounded=False,
         )
-    with gui.add_folder("Control law and gains", expand_by_default=False):
+    with gui.add_folder("Control law and gains", expand_by_default=False) as gains_folder:
         law = gui.add_dropdown(
             "Law",
             tuple(LAW_LABELS[k] for k in LAW_KINDS),
@@ -290,13 +292,20 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         exaggeration = NumberField(
             gui,
-            "Deflection drawn ×",
+            "Base deflection drawn ×",
             min=1.0,
             max=100.0,
             step=1.0,
             initial_value=defaults.exaggeration,
-            hint="The base deflection is drawn this many times larger than simulated.",
+            hint="The base deflection is drawn this many times larger than simulated (written beside the base). "
+            "Typing a factor fixes it (Auto off).",
             bounded=True,  # only drawn
+        )
+        auto_exaggeration = gui.add_checkbox(
+            "Auto deflection scale",
+            defaults.auto_exaggeration,
+            hint="The factor follows the motion: the recent largest base deflection is drawn at about a tenth "
+            "of the arm's reach (1-2-5 steps up to ×10000), so µm and mm both show.",
         )
         speed = gui.add_dropdown(
             "Speed",
@@ -305,9 +314,9 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="Simulated seconds per wall-clock second.",
         )
         shadow = gui.add_checkbox(
-            "Shadow run",
+            "Ghost run (suppression the other way)",
             True,
-            hint="A second simulation with the same inputs and kicks and suppression the other way: "
+            hint="The shadow run: a second simulation with the same inputs and kicks and suppression the other way: "
             "the blue ghost and the second plot lines.",
         )
     download = gui.add_button(
@@ -338,6 +347,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         target_folder=target_folder,
         target_text=target_text,
         target_speed=target_speed,
+        gains_folder=gains_folder,
         law=law,
         gains=gains,
         presets=presets,
@@ -346,6 +356,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         model=model_dd,
         menu=menu,
         exaggeration=exaggeration,
+        auto_exaggeration=auto_exaggeration,
         shadow=shadow,
         download=download,
     )
@@ -376,4 +387,5 @@ def show_presets(presets: dict[str, viser.GuiButtonGroupHandle], menu: ModelMenu
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**{name}**: {LIVE_SCENARIOS[name].description}. Reset restarts it."
+    preset = LIVE_SCENARIOS[name]
+    return f"**{name}**: {preset.description}.\n\n**Look at:** {preset.look} Reset restarts it."

@@ -55,7 +55,7 @@ def _locus_plot(gui: viser.GuiApi, title: str) -> viser.GuiUplotHandle:
         series=tuple(series),
         title=title,
         scales={"x": {"time": False, "auto": False, "range": (-1.0, 0.1)}, "y": {"auto": False, "range": (-1.0, 1.0)}},
-        axes=({"label": "Re λ (1/s)"}, {"label": "Im λ (1/s)", "size": 60}),
+        axes=({"label": "decay rate Re λ (1/s)"}, {"label": "ringing Im λ (1/s)", "size": 60}),
         legend={"show": True, "live": False},
         cursor={"show": False},
         aspect=1.3,
@@ -86,7 +86,9 @@ class GainExplorerView:
         self.server, self.session, self.gui = server, session, gui
         self.controls, self.connections = controls, connections
         g = server.gui
-        with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
+        with g.add_folder(
+            "Gain explorer", order=gui.download.order - 0.5, expand_by_default=True
+        ) as self.folder:  # above Download
             g.add_markdown(
                 "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
                 "(g_b, g_m) setting, coloured by "

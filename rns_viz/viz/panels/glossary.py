@@ -37,8 +37,14 @@ GLOSSARY: tuple[tuple[str, str, str, str], ...] = (
     ("damping gain", "g_b", "how hard the arm fights the base's swing, 1/s", "Eqs. (15), (16), (30)"),
     ("holding gain", "g_m", "how firmly the joints are held, 1/s", "Eqs. (15), (16), (30)"),
     ("decay rate", "σ_b", "how fast the base's swing dies out (bigger is faster), 1/s", "gain map"),
-    ("shadow run", "—", "a second simulation with the same pushes but suppression the other way: the ghost", ""),
-    ("real-time factor", "—", "simulated seconds per wall-clock second (1 = real time)", ""),
+    (
+        "ghost run (shadow run)",
+        "—",
+        "a second simulation with the same pushes but suppression the other way: the blue ghost",
+        "",
+    ),
+    ("drawn larger", "×", "the base's bend is drawn this many times larger than simulated (written beside it)", ""),
+    ("× real time", "—", "simulated seconds per wall-clock second (1 = real time)", ""),
     ("symmetric log", "—", "a plot scale that shows µm and mm on one axis (and both signs)", ""),
 )
 

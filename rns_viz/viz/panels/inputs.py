@@ -189,7 +189,9 @@ class Controls:
             g.kick, lambda _, c: s.kick(float(self.good(g.kick_peak)), c, self.kick_direction()), button=True
         )
         self._on_input(g.kick_peak, lambda v, c: None)  # read at the next kick
-        self._on_input(g.exaggeration, lambda v, c: None)  # read by the render thread
+        # read by the render thread; a factor typed or dragged is a fixed one
+        self._on_input(g.exaggeration, lambda v, c: self.show(g.auto_exaggeration, False))
+        self._on_input(g.auto_exaggeration, lambda v, c: None)  # read by the render thread
         self._on_input(g.suppression, lambda v, c: s.set_suppression(bool(v), c))
         self._on_input(g.pause, lambda _, c: self._pause_button(c), button=True)
         self._on_input(g.step, lambda _, c: s.single_step(1, c), button=True)

@@ -72,7 +72,8 @@ def lesson_markdown(status: LessonStatus | None) -> str:
     progress = f"**Done.** {then}" if status.done else status.progress
     return (
         f"**Lesson {status.number} of {status.count}: {status.title}**{mark}\n\n"
-        f"*Paper: {status.equation}*\n\n{status.text}\n\n**Task:** {status.task}\n\n{progress}"
+        f"{status.text}\n\n**Task:** {status.task}\n\n**Look at:** {status.look}\n\n{progress}\n\n"
+        f"*In the paper: {status.equation}*"
     )
 
 

@@ -133,7 +133,7 @@ class FsmsScene:
             thickness=1.5 * st.line_thickness,
             visible=False,
         )
-        self._add_labels()
+        self.base_label = self._add_labels()
         self.framed = framed_points(model)  # world points the camera frames
         self.set_initial_camera()
         self.q = model.q(model.spec.default_configuration)
@@ -148,8 +148,10 @@ class FsmsScene:
         if q_draw.shape != (self.model.nv,):
             raise ValueError(f"q must be (x_b, theta) with shape ({self.model.nv},), got {q_draw.shape}")
         q_draw[:m] *= exaggeration
-        self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
         with self.server.atomic():
+            if exaggeration != self.exaggeration:  # the factor written is the factor drawn
+                self.base_label.text = base_label(exaggeration)
+            self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
             self.robot.pose(q_draw)
             if isinstance(self.base_drawing, BoomDrawing):
                 self.base_drawing.pose(self.robot.base_placement())
@@ -274,16 +276,23 @@ class FsmsScene:
         self.trail_node.points = polyline_segments(pts)
         self.trail_node.visible = self.show_trail
 
-    def _add_labels(self) -> None:
+    def _add_labels(self) -> viser.LabelHandle:
+        """The names written in the scene; returns the base's label (it writes the drawn factor)."""
         scene, st = self.server.scene, self.style
-        scene.add_label("/base/label", "base x_b", position=st.base_label, anchor="bottom-center")
+        label = scene.add_label("/base/label", base_label(1.0), position=st.base_label, anchor="bottom-center")
         if isinstance(st.base, DoubleBeamStyle):
             scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
         elif isinstance(st.base, BoomStyle):
             scene.add_label("/boom/label", "clamp", position=(0.0, 0.0, 2.0 * st.base.radius), anchor="bottom-center")
         elif isinstance(st.base, CartSpringStyle):
             middle = 0.5 * (st.base.wall_x + st.base.attach[0])
-            scene.add_label("/spring/label", "k_b", position=(middle, 0.0, 0.05))
+            scene.add_label("/spring/label", "spring k_b", position=(middle, 0.0, 0.05))
+        return label
+
+
+def base_label(exaggeration: float) -> str:
+    """The base's label: what it is, and how much larger than simulated its deflection is drawn."""
+    return f"base vibration x_b (drawn ×{exaggeration:g})"
 
 
 def _make_base_drawing(

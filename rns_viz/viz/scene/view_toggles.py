@@ -51,14 +51,14 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
     ),
     (
         "coupling",
-        "Coupling momentum L (kg·m/s)",
+        "Momentum handed to the base L (kg·m/s)",
         True,
         "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8). "
         "Zero on a reactionless path.",
     ),
     (
         "null_vector",
-        "Null-space direction n (m/s per unit ū)",
+        "Reaction-free direction n (m/s per unit ū)",
         True,
         "Orange arrow at the hand: where the hand goes when the joints turn along n, the one direction "
         "that pushes the base not at all (Eq. 27); its length is J n, m/s per unit of ū.",

@@ -27,6 +27,7 @@ from rns_viz.live.operator.operator_lock import OperatorLock
 from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels import presentation
 from rns_viz.viz.panels.base_panel import BasePanel
 from rns_viz.viz.panels.control_panel import GuiElements, make_gui
 from rns_viz.viz.panels.inputs import Controls
@@ -60,13 +61,15 @@ class RnsApp:
         pace: bool = True,
         seat_on_connect: bool = True,
         pause_unwatched: bool = False,
+        present: bool = False,
     ) -> None:
         """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
         presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files
         offered in the model dropdown besides the bundled models;
         ``pace=False``: every page gets every update however slowly it draws; ``pause_unwatched``: the
         simulation pauses while no page is open and runs on when one comes (one student's app: its CPU
-        is then ~2 % of a core, not ~12 %)."""
+        is then ~2 % of a core, not ~12 %); ``present``: the projector's screen
+        (rns_viz.viz.panels.presentation)."""
         self.server = server
         self.session = session
         self.password = password
@@ -92,6 +95,11 @@ class RnsApp:
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
         self.keys = add_key_commands(server.gui, self.gui, self.controls, session, self.frame_robot, self._jog_setup)
         self.gui.frame_robot.on_click(lambda event: self.frame_robot(event.client))
+        self.present_style: viser.GuiHtmlHandle | None = None  # the projector's text size (--present)
+        if present:
+            g = self.gui
+            hidden = (self.renderer.explorer.folder, self.replay.folder, g.gains_folder, g.download)
+            self.present_style = presentation.present(server.gui, g.plots_panel, hidden)
         start = session.snapshot()
         self._unwatched_since: tuple[int, float] | None = (start.epoch, start.t)  # (epoch, t) the last client left
         self._visitors = threading.Lock()
@@ -219,12 +227,14 @@ def start_app(
     models: Sequence[str] = (),
     pace: bool = True,
     pause_unwatched: bool = False,
+    present: bool = False,
 ) -> RnsApp:
     """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
     ``lesson``: start at that lesson (1-based) of the model; ``model`` is a bundled name or a parameter
     file (ModelFileError names the element at fault), ``models`` more files for the model dropdown;
     ``pace=False``: every page gets every update however slowly it draws (for comparisons; see
-    :mod:`rns_viz.viz.server.page_pacing`); ``pause_unwatched``: see :class:`RnsApp`."""
+    :mod:`rns_viz.viz.server.page_pacing`); ``pause_unwatched``: see :class:`RnsApp`; ``present``:
+    larger text and fewer folders, for a projector."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
@@ -237,6 +247,7 @@ def start_app(
             pace=pace,
             seat_on_connect=host in LOOPBACK_HOSTS,
             pause_unwatched=pause_unwatched,
+            present=present,
         ).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
@@ -259,9 +270,12 @@ def serve(
     lesson: int | None = None,
     models: Sequence[str] = (),
     pause_unwatched: bool = False,
+    present: bool = False,
 ) -> None:
     """Serve the live app until interrupted (Ctrl+C). Binds 127.0.0.1 unless told otherwise."""
-    app = start_app(model, host, port, password, lesson=lesson, models=models, pause_unwatched=pause_unwatched)
+    app = start_app(
+        model, host, port, password, lesson=lesson, models=models, pause_unwatched=pause_unwatched, present=present
+    )
     print(f"rns_viz live app: http://{host}:{app.port}  (Ctrl+C to stop)")
     try:
         while True:

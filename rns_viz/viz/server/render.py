@@ -36,6 +36,7 @@ from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles
+from rns_viz.viz.server.drawn_factor import DrawnFactor
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
@@ -96,6 +97,7 @@ class Renderer:
         spatial = len(self.model.task_rows) == 3  # the handle moves in 3-D and gives (x, y, z)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
         self._reach = self.model.arm_reach
+        self.factor = DrawnFactor(self.model, self.gui, self.controls, self.view)  # the base's drawn factor
         self.teach = TeachScene(self.server, self.model, self.scene)
         self.rank = RankScene(self.server, self.model, self.scene.style)
         self.kind = operator_class(self.model)  # what the operator drives: the panel's folders, laws and words
@@ -148,6 +150,7 @@ class Renderer:
             g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
+        controls.show(g.auto_exaggeration, defaults.auto_exaggeration)
         kept = {name for name in KEPT_ACROSS_MODELS if self.view.on(name)}  # the viewer's choice, not the model's
         self.view.show_only(defaults.shown | kept)  # the new model's first look
         self._seen = _Seen()
@@ -181,8 +184,8 @@ class Renderer:
         if snap.epoch != seen.epoch or jumped:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
-        self._draw_state(snap)
-        exaggeration = float(self.controls.good(self.gui.exaggeration))
+        exaggeration = self.factor.for_frame(snap)
+        self._draw_state(snap, exaggeration)
         q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
         self.teach.draw(snap, q_shadow, exaggeration, self.view)
         self._apply_view()
@@ -223,15 +226,10 @@ class Renderer:
             seen.overlay_version = -1  # redrawn with or without the family
         self.explorer.show(view.on("gain_map"))
 
-    def _draw_state(self, snap: Snapshot) -> None:
-        """The arm, the base and the reaction arrow, when what a viewer sees changed."""
+    def _draw_state(self, snap: Snapshot, exaggeration: float) -> None:
+        """The arm, the base and the reaction arrow (and the base label's factor), when what a viewer sees changed."""
         seen = self._seen
-        exaggeration = float(self.controls.good(self.gui.exaggeration))
         q = self._drawn(snap.q, exaggeration) if np.all(np.isfinite(snap.q)) else seen.q
-        if exaggeration != seen.exaggeration:
-            label = self.server.scene.get_handle_by_name("/base/label")
-            if label is not None:
-                label.text = f"base x_b (drawn ×{exaggeration:g})"  # type: ignore[attr-defined]
         if q is not None and (not np.array_equal(q, seen.q) or exaggeration != seen.exaggeration):
             seen.q, seen.exaggeration = q, exaggeration
             with self.server.atomic():
