@@ -9,7 +9,7 @@ import pytest
 from rns_viz.live.session import Session
 
 
-@pytest.mark.parametrize(("model", "kick_n", "seconds"), [("trep", 0.8, 10.0), ("planar3r", 5.0, 16.0)])
+@pytest.mark.parametrize(("model", "kick_n", "seconds"), [("trep", 0.8, 13.0), ("planar3r", 5.0, 16.0)])
 def test_prediction_matches_the_measured_decay(model: str, kick_n: float, seconds: float) -> None:
     s = Session(model, realtime=False)
     try:

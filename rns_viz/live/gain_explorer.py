@@ -4,7 +4,8 @@ For the law and configuration in force, a background thread linearises the close
 (:mod:`rns_viz.analysis`, the simulator's own 1 ms step map, in a helper process) and derives the
 g_b x g_m map of decay rates, the root loci through the current gains and the predicted decay along
 the current reactionless path (TREP) or over the reactionless-reachable set (3R). After a kick the
-loop fits the decay of the measured base deflection, to set beside the prediction.
+loop measures the base deflection along the kick as the map predicts it (time to 10 % of its peak,
+decay there), to set beside the prediction.
 
 The loop calls :meth:`GainExplorer.context`, :meth:`retune`, :meth:`along`, :meth:`kicked` and
 :meth:`measure`; :meth:`collect` takes finished results. Readers take :attr:`GainExplorer.view`.
@@ -26,7 +27,7 @@ from rns_viz.analysis import (
     Locus,
     Modes,
     authority,
-    fit_decay,
+    measure_kick,
     modes_of,
     root_locus,
 )
@@ -45,11 +46,12 @@ FIT_UNTIL_S = 20.0  # ... until this long after it
 
 @dataclass(frozen=True)
 class Measured:
-    """The decay of the measured base deflection after the last kick."""
+    """The measured base deflection along the last kick (rns_viz.analysis.measure_kick)."""
 
-    rate: float  # 1/s, fitted to the peaks of |x_b|
+    rate: float  # 1/s, fitted to |y|'s peaks between 20 % and 5 % of its peak (nan: not yet, or too few swings)
     since: float  # s, the kick's time
-    seconds: float  # s of log fitted
+    seconds: float  # s of log read
+    settle_time: float = math.inf  # s after the kick's end until |y| stays under 10 % of its peak (inf: not yet)
 
 
 @dataclass(frozen=True)
@@ -83,6 +85,8 @@ class GainExplorer:
         self._loops: list[LinearLoop] | None = None
         self._key: tuple[str, LawKind, bytes] | None = None
         self.kick_t = math.nan  # s, the last kick
+        self._kick_end = math.nan  # s
+        self._kick_output = np.ones(1)  # y = this . x_b: the deflection along the last kick
         self._next_fit = math.inf
         self.view = GainView(0, "", "velocity", Gains(), "", None, None, None, None, (), None, None, None)
 
@@ -135,24 +139,31 @@ class GainExplorer:
 
         self.worker.submit("along", self._key, job)
 
-    def kicked(self, t: float) -> None:
-        self.kick_t, self._next_fit = t, t + FIT_FIRST_S
+    def kicked(self, t: float, duration: float = 0.0, direction: tuple[float, ...] | None = None) -> None:
+        """A kick started at t (s), lasting ``duration`` s along ``direction`` (None: the first base coordinate)."""
+        self.kick_t, self._next_fit, self._kick_end = t, t + FIT_FIRST_S, t + duration
+        if direction is not None and np.any(direction):
+            w = np.asarray(direction, dtype=float)
+            self._kick_output = w / float(w @ w)
+        else:
+            self._kick_output = np.ones(1)
         self._publish(measured=None)
 
     def fit_due(self, t: float) -> bool:
         return t >= self._next_fit
 
     def measure(self, sim: Simulator) -> None:
-        """Fit the decay since the last kick to the operated run's log of x_b; call when :meth:`fit_due`."""
+        """Read the deflection along the last kick from the operated run's log; call when :meth:`fit_due`."""
         t, log = sim.t, sim.log
         self._next_fit = t + FIT_EVERY_S if t < self.kick_t + FIT_UNTIL_S else math.inf
         rows = min(len(log), round((t - self.kick_t) / sim.dt) + 1)
-        times, x_b = log.column("t", rows), log.column("xb_1", rows)  # the first base coordinate
-        try:
-            fit = fit_decay(times, x_b, start=self.kick_t)
-        except ValueError:
-            return  # too few swings yet
-        self._publish(measured=Measured(fit.rate, self.kick_t, float(times[-1] - self.kick_t)))
+        times = log.column("t", rows)
+        y = sum(w * log.column(f"xb_{i + 1}", rows) for i, w in enumerate(self._kick_output) if w)
+        if rows < 3 or not np.any(y):
+            return
+        got = measure_kick(times, y, self._kick_end)
+        seconds = float(times[-1] - self.kick_t)
+        self._publish(measured=Measured(got.decay_rate, self.kick_t, seconds, got.settle_time))
 
     # -- results -----------------------------------------------------------------------------------
     def collect(self) -> bool:

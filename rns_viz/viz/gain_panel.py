@@ -20,7 +20,7 @@ from rns_viz.analysis import GAIN_RANGE, Locus, Modes
 from rns_viz.live.gain_explorer import GainView
 from rns_viz.live.session import Session
 from rns_viz.viz.connections import Connections
-from rns_viz.viz.gain_scene import LN10, GainScene, Quantity
+from rns_viz.viz.gain_scene import GainScene, Quantity
 from rns_viz.viz.gui import GAIN_SLIDERS, GuiElements
 from rns_viz.viz.inputs import Controls
 from rns_viz.viz.style import SceneStyle
@@ -238,18 +238,39 @@ def _fmt_rate(rate: float) -> str:
         return "…"
     if rate <= 0:
         return f"{rate:.3g} 1/s (grows)"
-    return f"{rate:.3g} 1/s, 10 % in {LN10 / rate:.3g} s"
+    return f"{rate:.3g} 1/s"
+
+
+def _fmt_time(seconds: float) -> str:
+    return f"10 % in {seconds:.3g} s after the kick" if math.isfinite(seconds) else "not under 10 % yet"
+
+
+def _prediction(view: GainView) -> str:
+    """The predicted decay at the gains in force, or why there is none."""
+    now = view.current
+    if now is None:
+        return "…"
+    if not bool(now.stable):
+        return f"none: the loop is unstable (σ_b {_fmt_rate(float(now.base_decay_rate))})"
+    why = now.why_not()
+    if why:
+        return f"**not predictable**: {why}"
+    return f"σ_b {_fmt_rate(float(now.base_decay_rate))}, {_fmt_time(float(now.base_time_to_10pct))}"
 
 
 def predicted_text(view: GainView) -> str:
-    """One line: predicted base decay at the gains in force, and after a kick the measured one."""
+    """One line: the predicted base decay at the gains in force (or why there is none), for which kick, and
+    after a kick the measured one."""
     gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
-    pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+    pred = f"**Base decay** at {gains}: predicted {_prediction(view)}"
+    if view.map is not None and view.current is not None and bool(view.current.stable):
+        pred += f" ({view.map.loop.regime}; the arm swings {float(view.current.swing):.2g} rad)"
     m = view.measured
     if m is None:
-        return f"{pred}; *kick the base to measure it* (fit of the |x_b| peaks, 4–20 s after the kick)."
-    fit = f"fit over {m.seconds:.1f} s after the kick at t = {m.since:.1f} s"
-    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({fit})."
+        return f"{pred}; *kick the base to measure it* (read 4–20 s after the kick)."
+    rate = "too few swings to fit a rate" if not math.isfinite(m.rate) else f"σ {_fmt_rate(m.rate)}"
+    read = f"{m.seconds:.1f} s of log after the kick at t = {m.since:.1f} s"
+    return f"{pred}; **measured** {_fmt_time(m.settle_time)}, {rate} ({read})."
 
 
 def authority_text(view: GainView, on_path: bool) -> str:
