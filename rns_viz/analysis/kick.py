@@ -174,15 +174,16 @@ def _bound_time(sigma: np.ndarray, terms: np.ndarray, level: np.ndarray) -> np.n
 
 def _sums(lam: np.ndarray, start: np.ndarray, step: np.ndarray, count: int, weights: np.ndarray) -> np.ndarray:
     """sum_i w_i e^(lambda_i t_k) at t_k = start + k step, k < count, for weights (K, W, s): (K, W, count).
-    e^(lambda t_k) by recurrence (a product per sample, no exponential); one batched product per sample."""
-    e = np.exp(lam * start[:, None])[..., None]
-    ratio = np.exp(lam * step[:, None])[..., None]
-    out = np.empty((*weights.shape[:2], count), dtype=complex)
+    e^(lambda t_k) by recurrence (a product per sample, no exponential), the loops' axis last (fastest)."""
+    e = np.exp(lam * start[:, None]).T.copy()  # (s, K)
+    ratio = np.exp(lam * step[:, None]).T.copy()
+    w = np.ascontiguousarray(weights.transpose(1, 2, 0))  # (W, s, K)
+    out = np.empty((count, *w.shape[::2]), dtype=complex)  # (count, W, K)
     for k in range(count):
         if k:
             e *= ratio
-        out[..., k] = (weights @ e)[..., 0]
-    return out
+        np.einsum("wsk,sk->wk", w, e, out=out[k])
+    return out.transpose(2, 1, 0)
 
 
 def _last_crossing(times: np.ndarray, values: np.ndarray, level: np.ndarray) -> np.ndarray:

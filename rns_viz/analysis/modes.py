@@ -13,7 +13,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.analysis.kick import KEPT, KEPT_PART, fold_pairs, pulse_states, pulse_steps, reason_text, respond
+from rns_viz.analysis.kick import (
+    KEPT,
+    KEPT_PART,
+    KickResponse,
+    fold_pairs,
+    pulse_states,
+    pulse_steps,
+    reason_text,
+    respond,
+)
 from rns_viz.analysis.linear import LinearLoop
 
 BASE_SHARE = 0.05  # a mode whose part in the kick response reaches this fraction of its peak is the base's
@@ -71,15 +80,15 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     shape = np.broadcast_shapes(gb.shape, gm.shape)[:-2]
     A = (blocks[0] + gb * blocks[1] + gm * blocks[2]).reshape(-1, d, d)
     mu, V = np.linalg.eig(A[:, k:, k:])
-    try:
-        W = np.linalg.inv(V)  # rows are the left eigenvectors, scaled so that W V = E
-    except np.linalg.LinAlgError:  # a defective pole somewhere in the batch (V singular there)
-        W = np.linalg.pinv(V)
     kick = loop.kick
     observed = T[:, k:]
     C_y = kick.output @ observed[np.flatnonzero(loop.kept < loop.m)]  # (seen,): y on the observable block
     C_L = loop.coupling @ loop.joint_rates @ observed  # (r, seen): L = S H_bm theta'
-    forcing = W @ (observed.T @ loop.force_input @ kick.weights)  # (K, seen): w_i^H B d
+    b = observed.T @ loop.force_input @ kick.weights
+    try:  # (K, seen): w_i^H B d, the left eigenvectors scaled so that W V = E
+        forcing = np.linalg.solve(V, np.broadcast_to(b, (len(V), len(b)))[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # a defective pole somewhere in the batch (V singular there)
+        forcing = np.linalg.pinv(V) @ b
     y_gain = (C_y @ V) * forcing  # (K, seen)
     seen = loop.rates(mu)
     hidden = _hidden_poles(blocks, k, np.broadcast_to(gb, (*shape, 1, 1)), np.broadcast_to(gm, (*shape, 1, 1)))
@@ -100,32 +109,12 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     base_rate = np.full(count, np.nan)
     dominant = np.zeros(count, dtype=int)
     if stable.any():
-        lam_s, mu_s = seen[stable], None if discrete is None else mu[stable]
-        xi = pulse_states(lam_s, mu_s, loop.dt, kick.duration, steps)  # (K, s, J) through the push
-        L_gain = (C_L @ V[stable]) * forcing[stable][:, None, :]  # (K, r, s)
-        y_pulse = kick.peak * np.einsum("ks,ksj->kj", y_gain[stable], xi).real
-        L_pulse = kick.peak * np.einsum("krs,ksj->krj", L_gain, xi).real
-        a, a_L = after[stable], kick.peak * L_gain * xi[:, None, :, -1]
-        # after the push, follow the modes with a part in y or L (a pair's on its upper pole, the lower goes):
-        # all with at least KEPT_PART of the largest anywhere (modes that cancel each other stay together)
-        part = np.abs(fold_pairs(lam_s, a))
-        part_L = np.linalg.norm(fold_pairs(lam_s, a_L), axis=1)
-        with np.errstate(invalid="ignore"):
-            part = np.nan_to_num(part / part.max(axis=1, keepdims=True) + part_L / part_L.max(axis=1, keepdims=True))
-        followed = max(int((part >= KEPT_PART).sum(axis=1).max()), 1)
-        order = np.argsort(-part, axis=1)[:, :followed]
-        real = np.take_along_axis(part, order, 1) >= KEPT_PART  # the others only fill the batch: they count 0
-        pick = lambda x: np.take_along_axis(x, order if x.ndim == 2 else order[:, None, :], axis=-1)  # noqa: E731
-        a_p, a_L_p = pick(a) * real, pick(a_L) * real[:, None, :]
-        resp = respond(pick(lam_s), a_p, a_L_p, y_pulse, L_pulse, loop.swing_map, steps * loop.dt, loop.joint_margins)
-        peak[stable], settle[stable], swing[stable], reason[stable] = (
-            resp.peak,
-            resp.settle_time,
-            resp.swing,
-            resp.reason,
-        )
-        base_rate[stable] = resp.decay_rate
-        dominant[stable] = k + np.take_along_axis(order, resp.dominant[:, None], 1)[:, 0]
+        rows = np.flatnonzero(stable)
+        resp = _respond(loop, seen[rows], None if discrete is None else mu[rows], V[rows], forcing[rows],
+                        y_gain[rows], C_L, steps)  # fmt: skip
+        peak[rows], settle[rows], swing[rows], reason[rows] = resp.peak, resp.settle_time, resp.swing, resp.reason
+        base_rate[rows] = resp.decay_rate
+        dominant[rows] = k + resp.dominant
     scale = np.where(stable, peak, amplitude.max(axis=1))
     share = amplitude / np.maximum(scale, 1e-300)[:, None]
     # a growing mode the base shows at all takes over in the end
@@ -152,6 +141,60 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
         swing=swing.reshape(shape),
         reason=reason.reshape(shape),
     )
+
+
+def _respond(
+    loop: LinearLoop,
+    lam: np.ndarray,
+    mu: np.ndarray | None,
+    V: np.ndarray,
+    forcing: np.ndarray,
+    y_gain: np.ndarray,
+    C_L: np.ndarray,
+    steps: np.ndarray,
+) -> KickResponse:
+    """The kick's response at K stable loops from their observable modes (lam, mu, V, forcing, y_gain: (K, s)
+    or (K, s, s)); its ``dominant`` indexes these modes.
+
+    Through the push every mode counts (fast ones too: they cancel slower ones while it lasts); after it,
+    :func:`~rns_viz.analysis.kick.respond` follows the modes with a part in y or in the integral of L (a
+    pair's on its upper pole, the lower goes) of at least KEPT_PART of the largest: modes that cancel each
+    other stay together. The loops go in two batches by how many modes they need (each batch is padded to
+    its largest, with parts 0).
+    """
+    kick = loop.kick
+    xi = pulse_states(lam, mu, loop.dt, kick.duration, steps)  # (K, s, J) through the push
+    L_gain = (C_L @ V) * forcing[:, None, :]  # (K, r, s)
+    y_pulse = kick.peak * np.einsum("ks,ksj->kj", y_gain, xi).real
+    L_pulse = kick.peak * np.einsum("krs,ksj->krj", L_gain, xi).real
+    a, a_L = kick.peak * y_gain * xi[..., -1], kick.peak * L_gain * xi[:, None, :, -1]
+    part = np.abs(fold_pairs(lam, a))
+    part_L = np.linalg.norm(fold_pairs(lam, a_L), axis=1) / np.abs(lam)
+    with np.errstate(invalid="ignore"):
+        part = np.nan_to_num(part / part.max(axis=1, keepdims=True) + part_L / part_L.max(axis=1, keepdims=True))
+    needed = np.maximum((part >= KEPT_PART).sum(axis=1), 1)
+    order = np.argsort(-part, axis=1)
+    split = int(np.percentile(needed, 80))
+    out = [np.empty(len(lam)) for _ in range(4)]
+    reason, dominant = np.empty(len(lam), dtype=int), np.empty(len(lam), dtype=int)
+    for rows in (np.flatnonzero(needed <= split), np.flatnonzero(needed > split)):
+        if len(rows) == 0:
+            continue
+        take = order[rows, : int(needed[rows].max())]
+        real = np.take_along_axis(part[rows], take, 1) >= KEPT_PART  # the batch's padding counts 0
+        lam_p, a_p, a_L_p = (_modes(x[rows], take) for x in (lam, a, a_L))
+        got = respond(lam_p, a_p * real, a_L_p * real[:, None, :], y_pulse[rows], L_pulse[rows], loop.swing_map,
+                      steps * loop.dt, loop.joint_margins)  # fmt: skip
+        for store, value in zip(out, (got.peak, got.settle_time, got.decay_rate, got.swing), strict=True):
+            store[rows] = value
+        reason[rows] = got.reason
+        dominant[rows] = np.take_along_axis(take, got.dominant[:, None], 1)[:, 0]
+    return KickResponse(*out[:3], dominant, out[3], reason)
+
+
+def _modes(x: np.ndarray, take: np.ndarray) -> np.ndarray:
+    """The modes ``take`` (K, p) of x (K, s) or (K, r, s)."""
+    return np.take_along_axis(x, take if x.ndim == 2 else take[:, None, :], axis=-1)
 
 
 def _hidden_poles(blocks: list[np.ndarray], k: int, gb: np.ndarray, gm: np.ndarray) -> np.ndarray:
