@@ -26,8 +26,8 @@ from rns_viz.viz.inputs import Controls
 from rns_viz.viz.style import SceneStyle
 
 QUANTITIES: dict[str, Quantity] = {
-    "base mode σ_b (1/s)": "base",
-    "base mode time to 10 % (s)": "time",
+    "base decay σ_b (1/s)": "base",
+    "base time to 10 % (s)": "time",
     "arm mode σ_a (1/s)": "arm",
 }
 RIGHT = 0.15  # the locus plots show Re λ up to this fraction of their left reach (unstable poles)
@@ -88,14 +88,15 @@ class GainExplorerView:
         with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
             g.add_markdown(
                 "**Gain map** in the scene (left of the robot): each cell is a (g_b, g_m) setting, coloured by "
-                "how fast the closed loop, linearised about the current pose, damps the chosen mode. "
-                "**Click a cell** to apply its gains."
+                "how fast the closed loop, linearised about the current pose, damps a kick (the one in the map's "
+                "title; faded, hatched cells: it cannot say). **Click a cell** to apply its gains."
             )
             self.quantity = g.add_dropdown(
                 "Map shows",
                 tuple(QUANTITIES),
                 initial_value=next(iter(QUANTITIES)),
-                hint="Base mode: the poles a base kick excites; arm mode: the others (Sec. VIII: two subsystems).",
+                hint="Base: how a kick decays, σ_b = ln 10 / the time it takes to fall to 10 % of its peak; arm "
+                "mode: the slowest pole a kick hardly shows (Sec. VIII: two subsystems).",
             )
             self.meaning = g.add_markdown("")
             self.predicted = g.add_markdown("")
