@@ -92,10 +92,10 @@ class LinearLoop:
     kept: np.ndarray  # (d,) indices into the full state of length 2 (m + n)
     m: int  # base coordinates
     nv: int  # m + n
-    M: np.ndarray  # (nv, nv) inertia matrix of Eq. (1) at the equilibrium, for mode shares
+    M: np.ndarray  # (nv, nv) inertia matrix of Eq. (1) at the equilibrium
     basis: np.ndarray  # (d, d) orthonormal: its last ``seen`` columns span the modes x_b can show
     seen: int  # dimension of the observable part (x_b) of A(g_b, g_m), the same at every gain
-    force_input: np.ndarray  # (d, m): state change per N of base force held over a step (continuous: per N s)
+    force_input: np.ndarray  # (d, m): state change per N of base force held over a step (continuous: rate per N)
     coupling: np.ndarray  # (r, n) S H_bm at the equilibrium, kg m (kg m^2 on a rotation)
     joint_margins: tuple[np.ndarray, np.ndarray]  # (n,) each: rad the joints may turn down / up to their limits
     kick: Kick  # the kick whose response the modes are grouped by (the model's default kick)
@@ -117,10 +117,6 @@ class LinearLoop:
     def poles(self, g_b: float | np.ndarray, g_m: float | np.ndarray) -> np.ndarray:
         """Closed-loop poles lambda (1/s), (..., d), for gains that broadcast together."""
         return self.rates(np.linalg.eigvals(self.matrix(g_b, g_m)))
-
-    def impulse_input(self) -> np.ndarray:
-        """B (d, m): the state jump per unit impulse of base force (N s), (0, M^-1 e_b) on the kept states."""
-        return _impulse_input(self.M, self.m, self.kept)
 
     @property
     def regime(self) -> str:
