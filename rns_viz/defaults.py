@@ -46,6 +46,7 @@ class ModelDefaults:
     kick_peak_N: float = 1.0  # the kick button's default peak force
     kick_duration_s: float = 0.1  # half-sine duration of a kick
     kick_range_N: float = 5.0  # the kick slider's half range
+    kick_axis: int = 0  # the base coordinate a kick pushes along first (the panel's choice, the gain map's kick)
     exaggeration: float = 10.0  # drawn deflection factor
     target_speed_m_s: float = 0.5  # speed limit of the smoothed end-effector target
 
@@ -90,6 +91,7 @@ MODEL_DEFAULTS: dict[str, ModelDefaults] = {
         kick_peak_N=5.0,
         kick_duration_s=0.1,
         kick_range_N=20.0,
+        kick_axis=1,  # y: sideways, where the boom is soft (along x it is stiff)
         exaggeration=50.0,
     ),
     "trep2": ModelDefaults(

@@ -1,7 +1,8 @@
 """Gain maps and root loci of the linearised closed loop (rns_viz.analysis.linear), and their CSV.
 
 A map is the base and arm decay rates over a log grid of (g_b, g_m), both 1/s, about one rest
-configuration; a locus is the closed-loop poles as one gain sweeps with the other fixed.
+configuration, with the base's response to the loop's kick (its time to 10 %, whether the linear loop
+speaks for it); a locus is the closed-loop poles as one gain sweeps with the other fixed.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from typing import IO, Literal
 
 import numpy as np
 
+from rns_viz.analysis.kick import Kick
 from rns_viz.analysis.linear import LinearLoop, StateView, law_kind, linearise
 from rns_viz.analysis.modes import Modes, modes_of
 from rns_viz.control import Gains, LawKind
@@ -60,6 +62,9 @@ CSV_COLUMNS = (
     "base_time_to_10pct_s",
     "arm_time_to_10pct_s",
     "base_frequency_rad_per_s",
+    "predictable",
+    "arm_swing_rad",
+    "not_predictable_because",
 )
 
 
@@ -93,9 +98,20 @@ class GainMap:
     def stable(self) -> np.ndarray:
         return self.modes.stable
 
-    def best(self) -> tuple[float, float, float]:
-        """(g_b, g_m, sigma_b) of the stable grid point whose base decays fastest."""
-        rate = np.where(self.stable, self.base_decay_rate, -np.inf)
+    @property
+    def predictable(self) -> np.ndarray:
+        """Stable, and the linear loop speaks for the run after the map's kick (``modes.why_not`` says why not)."""
+        return self.modes.predictable
+
+    @property
+    def base_time_to_10pct(self) -> np.ndarray:
+        """s after the kick's end until the base deflection stays under 10 % of its peak."""
+        return self.modes.base_time_to_10pct
+
+    def best(self, predictable: bool = True) -> tuple[float, float, float]:
+        """(g_b, g_m, sigma_b) of the grid point whose base decays fastest among the predictable ones
+        (``predictable=False``: among all stable ones)."""
+        rate = np.where(self.predictable if predictable else self.stable, self.base_decay_rate, -np.inf)
         i, j = np.unravel_index(int(np.argmax(rate)), rate.shape)
         return float(self.g_b[i]), float(self.g_m[j]), float(rate[i, j])
 
@@ -110,6 +126,8 @@ class GainMap:
             m.base_time_to_10pct,
             m.arm_time_to_10pct,
             m.base_frequency,
+            m.predictable,
+            m.swing,
         )
         writer = csv.writer(handle)
         writer.writerow(CSV_COLUMNS)
@@ -117,7 +135,7 @@ class GainMap:
         for i, g_b in enumerate(self.g_b):
             for j, g_m in enumerate(self.g_m):
                 values = [_cell(c[i, j]) for c in columns]
-                writer.writerow([repr(float(g_b)), repr(float(g_m)), *values])
+                writer.writerow([repr(float(g_b)), repr(float(g_m)), *values, m.why_not((i, j))])
                 rows += 1
         return rows
 
@@ -149,9 +167,10 @@ def gain_map(
     view: StateView = "discrete",
     dt: float = 1e-3,
     gains: Gains | None = None,
+    kick: Kick | None = None,
 ) -> GainMap:
     """Linearise about theta at rest (default configuration by default) and map the grid."""
-    return map_of(linearise(model, law, theta, view=view, dt=dt, gains=gains), g_b, g_m)
+    return map_of(linearise(model, law, theta, view=view, dt=dt, gains=gains, kick=kick), g_b, g_m)
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from rns_viz.defaults import KICK_LEVER_M
+from rns_viz.defaults import KICK_LEVER_M, defaults_for
 from rns_viz.live.published.plot_buffers import BASE_COORDINATES
 from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.model import FsmsModel
@@ -99,7 +99,7 @@ class BasePanel:
         """The shown model's base coordinates."""
         return len(self.turns)
 
-    def for_model(self, model: FsmsModel, default_axis: int = 1) -> None:
+    def for_model(self, model: FsmsModel, default_axis: int | None = None) -> None:
         """Show the panel for ``model`` (hidden for a 1-DOF base)."""
         self.turns = model.base_rotational
         self.folder.visible = model.m > 1
@@ -108,7 +108,8 @@ class BasePanel:
         names = coordinate_names(model)
         with self.controls.quiet():
             self.direction.options = (*(n.split(" ")[0] for n in names), ALL)
-        self.controls.show(self.direction, self.direction.options[min(default_axis, model.m - 1)])
+        axis = defaults_for(model.name).kick_axis if default_axis is None else default_axis  # the gain map's kick
+        self.controls.show(self.direction, self.direction.options[min(axis, model.m - 1)])
         for i, box in enumerate(self.boxes):
             box.visible = i < model.m
             if i < model.m:
