@@ -2,10 +2,11 @@
 
 Run on demand:  python benchmarks/bench_gains.py [--rounds 15] [--size 60]
 
-Per model and law (TREP with (30), the 3R with (15), and both with the other laws):
+Per model and law (TREP with (30), the 3R with (15), both with the other laws, and boom7 with (15)):
 - "linearise": :func:`rns_viz.analysis.linearise`, three central-difference Jacobians of the 1 ms
   step map (done once per model, law and configuration);
-- "map": :func:`rns_viz.analysis.map_of` on that loop, the part repeated when the grid changes;
+- "map": :func:`rns_viz.analysis.map_of` on that loop, the part repeated when the grid changes (the
+  poles, and each stable cell's response to the model's kick: peak, time to 10 %, arm swing);
 - "map + linearise": :func:`rns_viz.analysis.gain_map`, what a view pays when the model, law or
   configuration changes; target <= 100 ms;
 - "plain eig": ``np.linalg.eig`` of the full A(g_b, g_m) at every grid point, the obvious way to
@@ -33,7 +34,13 @@ from rns_viz.control import Gains
 from rns_viz.model import FsmsModel
 from rns_viz.sim import Simulator
 
-CASES = (("trep", "velocity"), ("planar3r", "acceleration"), ("trep", "acceleration"), ("planar3r", "velocity"))
+CASES = (
+    ("trep", "velocity"),
+    ("planar3r", "acceleration"),
+    ("trep", "acceleration"),
+    ("planar3r", "velocity"),
+    ("boom7", "acceleration"),
+)
 
 
 def _median_ms(fn: Callable[[], object], rounds: int) -> float:
@@ -49,7 +56,7 @@ def _median_ms(fn: Callable[[], object], rounds: int) -> float:
 def _step_us(model: FsmsModel, law: str, steps: int = 2000) -> tuple[float, bool]:
     theta = model.spec.default_configuration
     sim = Simulator(model, build_law(model, law, theta, Gains(g_b=24.0, g_m=20.0)), q0=model.q(theta))
-    sim.v = np.r_[1e-3, np.zeros(model.n)]
+    sim.v = np.r_[1e-3, np.zeros(model.nv - 1)]
     sim.run(0.1)  # warm-up
     samples = []
     for _ in range(steps):

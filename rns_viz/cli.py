@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 from collections.abc import Sequence
@@ -199,9 +200,15 @@ def cmd_gains(args: argparse.Namespace) -> None:
     with _open_for_writing(out) as handle:
         rows = result.write_csv(handle)
     best_b, best_m, best_rate = result.best()
+    fastest = (
+        f"fastest predictable base decay {best_rate:.3g} /s (10 % in {math.log(10.0) / best_rate:.3g} s) "
+        f"at g_b = {best_b:.3g}, g_m = {best_m:.3g} /s"
+        if result.predictable.any()
+        else "no cell the linear loop can predict"
+    )
     print(
-        f"{model.name}, law {EQUATIONS[result.loop.law]}: {rows} points, {result.stable.mean():.0%} stable; "
-        f"fastest base decay {best_rate:.3g} /s at g_b = {best_b:.3g}, g_m = {best_m:.3g} /s; wrote {out}"
+        f"{model.name}, law {EQUATIONS[result.loop.law]}: {rows} points, {result.stable.mean():.0%} stable, "
+        f"{result.predictable.mean():.0%} predictable {result.loop.regime}; {fastest}; wrote {out}"
     )
 
 

@@ -189,7 +189,8 @@ def fig12(out: Path) -> Path:
 
 
 def _gain_map(out: Path, name: str, law: str) -> Path:
-    """Base and arm decay rates over g_b x g_m (1/s, log colour), unstable region grey, paper's gains marked."""
+    """Base and arm decay rates over g_b x g_m (1/s, log colour), unstable region grey, cells the linear loop
+    cannot predict for the model's kick hatched, paper's gains marked."""
     from matplotlib.colors import ListedColormap, LogNorm
 
     model = FsmsModel.from_name(name)
@@ -201,10 +202,13 @@ def _gain_map(out: Path, name: str, law: str) -> Path:
     positive = np.concatenate([r[result.stable & (r > 0)] for r in rates])
     norm = LogNorm(vmin=max(positive.min(), 1e-3), vmax=positive.max())
     grey = ListedColormap(["0.6"])
-    for ax, rate, title in zip(axes, rates, ("base mode", "arm modes"), strict=True):
+    for ax, rate, title in zip(axes, rates, ("base", "arm modes"), strict=True):
         ax.pcolormesh(result.g_m, result.g_b, np.ma.masked_where(result.stable, rate), cmap=grey, shading="nearest")
         shown = np.ma.masked_where(~result.stable | ~(rate > 0), rate)
         image = ax.pcolormesh(result.g_m, result.g_b, shown, cmap="viridis", norm=norm, shading="nearest")
+        odd = (result.stable & ~result.predictable).astype(float)
+        if odd.any():
+            ax.contourf(result.g_m, result.g_b, odd, levels=[0.5, 1.5], colors="none", hatches=["////"])
         for k, mark in enumerate(PAPER_GAINS.get((name, loop.law), ())):
             sigma = float(modes_of(loop, mark.g_b, mark.g_m).base_decay_rate)
             ax.plot(mark.g_m, mark.g_b, "o", mfc="none", mec="tab:red", ms=9, mew=2)
@@ -212,14 +216,16 @@ def _gain_map(out: Path, name: str, law: str) -> Path:
             ax.annotate(text, (mark.g_m, mark.g_b), (8, 8 - 14 * k), textcoords="offset points", color="w", fontsize=8)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_title(f"{title}: slowest decay rate σ [1/s] (grey: unstable)", fontsize=9)
+        what = "σ_b = ln 10 / time to 10 %" if title == "base" else "slowest decay rate σ_a"
+        ax.set_title(f"{title}: {what} [1/s]", fontsize=9)
         ax.set_xlabel("g_m [1/s]")
         fig.colorbar(image, ax=ax)
     axes[0].set_ylabel("g_b [1/s]")
-    theta = np.round(np.rad2deg(loop.theta), 1).tolist()
     fig.suptitle(
-        f"Gain map: {model.name}, law {EQUATIONS[loop.law]} at rest at θ = {theta} deg, 1 ms step map "
-        f"({result.stable.mean():.0%} of the grid stable)",
+        f"Gain map: {model.name}, law {EQUATIONS[loop.law]}, {loop.regime} (1 ms step map; "
+        f"{result.stable.mean():.0%} of the grid stable, {result.predictable.mean():.0%} predictable)\n"
+        "grey: unstable; hatched: the linear loop cannot predict this kick "
+        "(arm swing > 0.5 rad, a joint limit, no decay after it)",
         fontsize=10,
     )
     return _save(fig, out / f"gain_map_{name}.png")

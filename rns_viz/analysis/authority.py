@@ -8,10 +8,12 @@ deflection after a kick, to set beside the prediction.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from rns_viz.analysis.kick import LN10, SETTLE_LEVEL
 from rns_viz.analysis.linear import LinearLoop, StateView, linearise
 from rns_viz.analysis.modes import modes_of
 from rns_viz.control import Gains, LawKind
@@ -100,3 +102,28 @@ def fit_decay(t: np.ndarray, x: np.ndarray, start: float | None = None, floor: f
             raise ValueError("too few samples above the floor to fit a decay")
     slope, intercept = np.polyfit(t[peaks], np.log(s[peaks]), 1)
     return DecayFit(float(-slope), float(np.exp(intercept)), t[peaks], s[peaks], method)
+
+
+@dataclass(frozen=True)
+class KickMeasure:
+    """What a logged kick shows, read as :mod:`rns_viz.analysis.kick` predicts it."""
+
+    peak: float  # max |y| since the kick, units of y
+    settle_time: float  # s after the kick's end until |y| stays under 10 % of the peak (inf: not yet)
+    decay_rate: float  # 1/s: ln 10 / settle_time (nan: not settled yet)
+
+
+def measure_kick(t: np.ndarray, y: np.ndarray, kick_end: float, quiet: float | None = None) -> KickMeasure:
+    """Peak, time to 10 % and decay of a deflection y(t) logged from a kick's start; ``kick_end`` in s.
+
+    The time to 10 % counts once |y| has stayed under 10 % of its peak for ``quiet`` s at the end of the
+    log (default: as long as it took to get there, at least a second): a swing may still come back."""
+    t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
+    a = np.abs(y)
+    top = int(np.argmax(a))
+    above = np.flatnonzero((t >= kick_end) & (a >= SETTLE_LEVEL * a[top]))
+    settle = max((float(t[above[-1]]) if len(above) else kick_end) - kick_end, 0.0)
+    if float(t[-1]) - kick_end - settle < (max(settle, 1.0) if quiet is None else quiet):
+        settle = math.inf
+    rate = LN10 / settle if 0 < settle < math.inf else math.nan
+    return KickMeasure(float(a[top]), settle, rate)

@@ -1,7 +1,8 @@
 """Gain maps and root loci of the linearised closed loop (rns_viz.analysis.linear), and their CSV.
 
 A map is the base and arm decay rates over a log grid of (g_b, g_m), both 1/s, about one rest
-configuration; a locus is the closed-loop poles as one gain sweeps with the other fixed.
+configuration, with the base's response to the loop's kick (its time to 10 %, whether the linear loop
+speaks for it); a locus is the closed-loop poles as one gain sweeps with the other fixed.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from typing import IO, Literal
 
 import numpy as np
 
+from rns_viz.analysis.kick import Kick
 from rns_viz.analysis.linear import LinearLoop, StateView, law_kind, linearise
 from rns_viz.analysis.modes import Modes, modes_of
 from rns_viz.control import Gains, LawKind
@@ -61,6 +63,9 @@ CSV_COLUMNS: dict[str, str] = {
     "base_time_to_10pct": "s",  # ln 10 / sigma_b (inf if it does not decay)
     "arm_time_to_10pct": "s",
     "base_frequency": "rad/s",  # |Im lambda| of the slowest base pole
+    "predictable": "1 = predictable",  # the kick's response stays in the linear range (else the map hatches it)
+    "swing": "rad",  # the joints' largest swing outside the RNS while absorbing the kick
+    "reason": "code",  # why not predictable: 0 it is, 1 swing too large, 2 a joint limit, 3 decays within the kick
 }
 
 
@@ -94,9 +99,20 @@ class GainMap:
     def stable(self) -> np.ndarray:
         return self.modes.stable
 
-    def best(self) -> tuple[float, float, float]:
-        """(g_b, g_m, sigma_b) of the stable grid point whose base decays fastest."""
-        rate = np.where(self.stable, self.base_decay_rate, -np.inf)
+    @property
+    def predictable(self) -> np.ndarray:
+        """Stable, and the linear loop speaks for the run after the map's kick (``modes.why_not`` says why not)."""
+        return self.modes.predictable
+
+    @property
+    def base_time_to_10pct(self) -> np.ndarray:
+        """s after the kick's end until the base deflection stays under 10 % of its peak."""
+        return self.modes.base_time_to_10pct
+
+    def best(self, predictable: bool = True) -> tuple[float, float, float]:
+        """(g_b, g_m, sigma_b) of the grid point whose base decays fastest among the predictable ones
+        (``predictable=False``: among all stable ones)."""
+        rate = np.where(self.predictable if predictable else self.stable, self.base_decay_rate, -np.inf)
         i, j = np.unravel_index(int(np.argmax(rate)), rate.shape)
         return float(self.g_b[i]), float(self.g_m[j]), float(rate[i, j])
 
@@ -129,9 +145,10 @@ def gain_map(
     view: StateView = "discrete",
     dt: float = 1e-3,
     gains: Gains | None = None,
+    kick: Kick | None = None,
 ) -> GainMap:
     """Linearise about theta at rest (default configuration by default) and map the grid."""
-    return map_of(linearise(model, law, theta, view=view, dt=dt, gains=gains), g_b, g_m)
+    return map_of(linearise(model, law, theta, view=view, dt=dt, gains=gains, kick=kick), g_b, g_m)
 
 
 @dataclass(frozen=True)

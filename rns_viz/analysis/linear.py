@@ -29,6 +29,7 @@ from typing import Literal
 
 import numpy as np
 
+from rns_viz.analysis.kick import Kick, default_kick
 from rns_viz.control import AccelerationLaw, FixedReference, Gains, LawKind, TorqueLaw, VelocityLaw
 from rns_viz.control.common import ControlLaw
 from rns_viz.model import FsmsModel
@@ -45,6 +46,7 @@ LAW_NAMES: dict[str, LawKind] = {
 EQUATIONS: dict[LawKind, str] = {"acceleration": "(15)", "torque": "(16)", "velocity": "(30)"}
 StateView = Literal["discrete", "continuous"]
 FD_STEP = 1e-6  # central-difference step on every state coordinate (m, rad, m/s, rad/s)
+FORCE_STEP = 1e-3  # N (N m): central-difference step on the base force
 
 
 def law_kind(name: str) -> LawKind:
@@ -90,9 +92,14 @@ class LinearLoop:
     kept: np.ndarray  # (d,) indices into the full state of length 2 (m + n)
     m: int  # base coordinates
     nv: int  # m + n
-    M: np.ndarray  # (nv, nv) inertia matrix of Eq. (1) at the equilibrium, for mode shares
+    M: np.ndarray  # (nv, nv) inertia matrix of Eq. (1) at the equilibrium
     basis: np.ndarray  # (d, d) orthonormal: its last ``seen`` columns span the modes x_b can show
     seen: int  # dimension of the observable part (x_b) of A(g_b, g_m), the same at every gain
+    force_input: np.ndarray  # (d, m): state change per N of base force held over a step (continuous: rate per N)
+    coupling: np.ndarray  # (r, n) S H_bm at the equilibrium, kg m (kg m^2 on a rotation)
+    joint_margins: tuple[np.ndarray, np.ndarray]  # (n,) each: rad the joints may turn down / up to their limits
+    kick: Kick  # the kick whose response the modes are grouped by (the model's default kick)
+    base_names: tuple[str, ...]  # the base coordinates ("x", "y", ..., "rz")
 
     def matrix(self, g_b: float | np.ndarray, g_m: float | np.ndarray) -> np.ndarray:
         """A at the given gains (1/s); arrays of gains broadcast to (..., d, d)."""
@@ -111,9 +118,21 @@ class LinearLoop:
         """Closed-loop poles lambda (1/s), (..., d), for gains that broadcast together."""
         return self.rates(np.linalg.eigvals(self.matrix(g_b, g_m)))
 
-    def impulse_input(self) -> np.ndarray:
-        """B (d, m): the state jump per unit impulse of base force (N s), (0, M^-1 e_b) on the kept states."""
-        return _impulse_input(self.M, self.m, self.kept)
+    @property
+    def regime(self) -> str:
+        """Where the map's predictions hold, in words: the kick and the rest configuration."""
+        theta = ", ".join(f"{a:.0f}" for a in np.rad2deg(self.theta))
+        return f"after {self.kick.words(self.base_names)}, arm at rest at θ = ({theta})°"
+
+    @property
+    def swing_map(self) -> np.ndarray:
+        """(n, r): (S H_bm)^+, the joint motion outside the RNS that makes a coupling momentum integral."""
+        return np.linalg.pinv(self.coupling)
+
+    @property
+    def joint_rates(self) -> np.ndarray:
+        """(n, d): picks theta' from the kept states."""
+        return np.eye(len(self.kept))[np.searchsorted(self.kept, self.nv + np.arange(self.m, self.nv))]
 
     @property
     def neutral(self) -> int:
@@ -140,11 +159,18 @@ class ClosedLoop:
         tau = self.law(0.0, q, v).tau
         return np.concatenate((v, self.plant.acceleration(q, v, tau, None)))
 
-    def step(self, x: np.ndarray) -> np.ndarray:
-        """x_{k+1}: the torque at x held over one RK4 step of dt, as in :class:`~rns_viz.sim.Simulator`."""
+    def step(self, x: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
+        """x_{k+1}: the torque at x held over one RK4 step of dt, as in :class:`~rns_viz.sim.Simulator`,
+        with a base force (N) held over the step."""
         nv = self.model.nv
         tau = self.law(0.0, x[:nv], x[nv:]).tau
-        return self.plant.rk4_state_step(x, tau, None, self.dt)
+        return self.plant.rk4_state_step(x, tau, force, self.dt)
+
+    def force_jacobian(self) -> np.ndarray:
+        """(2 nv, m): d x_{k+1} / d f (per N) at the equilibrium for a force held over the step, by central
+        differences (the law sees only x_k, so this does not depend on the gains)."""
+        x0, h = self.x0, FORCE_STEP
+        return np.column_stack([(self.step(x0, h * e) - self.step(x0, -h * e)) / (2 * h) for e in np.eye(self.model.m)])
 
     def jacobian(self, view: StateView) -> np.ndarray:
         """Central-difference Jacobian of :meth:`step` or :meth:`rhs` at the equilibrium."""
@@ -166,11 +192,13 @@ def linearise(
     view: StateView = "discrete",
     dt: float = 1e-3,
     gains: Gains | None = None,
+    kick: Kick | None = None,
 ) -> LinearLoop:
     """Linearise plant + law about theta at rest (default: the model's default configuration).
 
     ``gains`` supplies the gains other than g_b and g_m (the servo bandwidth of (30), 300 rad/s by
-    default); g_b and g_m are the map's axes.
+    default); g_b and g_m are the map's axes. ``kick`` (default: the model's, :func:`default_kick`)
+    is the push whose response the modes are read from.
     """
     kind = law_kind(law)
     if view not in ("discrete", "continuous"):
@@ -184,6 +212,7 @@ def linearise(
     if not drift < 1e-9:  # e.g. gravity along a base axis loads the spring: x_b = 0 is no equilibrium
         raise ValueError(f"{model.name}: theta at rest with x_b = 0 is not an equilibrium (|x'| = {drift:.3g})")
     A0 = loop.jacobian(view)
+    force = loop.force_jacobian() if view == "discrete" else None
     loop.retune(_with(base, 1.0, 0.0))
     A_b = loop.jacobian(view) - A0
     loop.retune(_with(base, 0.0, 1.0))
@@ -192,6 +221,12 @@ def linearise(
     sub = np.ix_(kept, kept)
     A0, A_b, A_m = A0[sub], A_b[sub], A_m[sub]
     M = model.mass_matrix(loop.x0[: model.nv]).copy()
+    force_input = _impulse_input(M, model.m, kept) if force is None else force[kept]
+    kick = kick or default_kick(model)
+    if len(kick.direction) != model.m:
+        raise ValueError(
+            f"{model.name}'s base has {model.m} coordinates; the kick's direction gives {len(kick.direction)}"
+        )
     shifted = A0 - np.eye(len(kept)) if view == "discrete" else A0  # same invariant subspaces
     C = np.eye(2 * model.nv)[: model.m][:, kept]  # x_b
     basis, seen = _observable_basis((shifted, A_b, A_m), C)
@@ -211,6 +246,11 @@ def linearise(
         M=M,
         basis=basis,
         seen=seen,
+        force_input=force_input,
+        coupling=model.coupling_matrix(loop.x0[: model.nv]).copy(),
+        joint_margins=(theta - model.lower, model.upper - theta),
+        kick=kick,
+        base_names=tuple(j.removeprefix("base_") for j in model.spec.base.joints),
     )
 
 

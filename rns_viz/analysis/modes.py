@@ -1,13 +1,10 @@
-"""Closed-loop modes split into the base mode and the arm modes, batched over many gain settings.
+"""Closed-loop modes, the base's response to the loop's kick, and the base/arm grouping, batched over gains.
 
-Which modes are "the base": those the base deflection shows after a kick. For mode i with right and
-left eigenvectors v_i, w_i (w_i^H v_j = delta_ij) the response of x_b to an impulse of base force is
-sum_i (C v_i)(w_i^H B) e^(lambda_i t), C picking x_b and B = (0, M^-1 S^T) the velocity jump of a unit
-impulse. The share of mode i, ||C v_i|| ||w_i^H B|| over the sum of all, is unit-free (scaling a state
-coordinate scales v_i and w_i inversely). Modes with at least ``BASE_SHARE`` form the base group,
-the rest the arm group. (The classical participation factors |v_ki w_ki| of x_b, x_b' misplace the
-arm's slow return at high g_b and low g_m, which moves the base while the base states barely steer
-it: the kick share counts it as base, which is what a student measures after a kick.)
+What the map predicts is what a student sees after pressing Kick (:mod:`rns_viz.analysis.kick`): the
+base deflection's peak, its time to 10 % of the peak and the mean decay rate that makes, and whether the
+linear loop can speak for that run at all. The base group is the modes whose part in that response
+reaches ``BASE_SHARE`` of its peak, the arm group the rest (in a growing loop every mode the base shows
+at all is the base's: the fastest growth takes over).
 """
 
 from __future__ import annotations
@@ -16,31 +13,45 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rns_viz.analysis.kick import (
+    KEPT,
+    KEPT_PART,
+    KickResponse,
+    fold_pairs,
+    pulse_states,
+    pulse_steps,
+    reason_text,
+    respond,
+)
 from rns_viz.analysis.linear import LinearLoop
 
-BASE_SHARE = 0.05  # a mode with at least this share of x_b's kick response belongs to the base group
+BASE_SHARE = 0.05  # a mode whose part in the kick response reaches this fraction of its peak is the base's
+UNSTABLE_SHARE = 1e-6  # in a growing loop, every mode with more than this share (numerically not 0) is the base's
 STABLE_MARGIN = 1e-6  # 1/s: stable if every kept mode decays faster than this
 LN10 = float(np.log(10.0))
 
 
 @dataclass(frozen=True)
 class Modes:
-    """Eigen-analysis at K gain settings (leading shape ``shape``); rates in 1/s."""
+    """Eigen-analysis and kick response at K gain settings (leading shape ``shape``); rates in 1/s."""
 
     poles: np.ndarray  # (*shape, d) complex lambda, 1/s (continuous-equivalent for the step map)
-    base_share: np.ndarray  # (*shape, d) share of x_b's response to a base impulse, sums to 1
+    base_share: np.ndarray  # (*shape, d) each mode's envelope in the kick response over its peak (0 if unseen)
     is_base: np.ndarray  # (*shape, d) bool: the base group (base_share >= BASE_SHARE)
-    base_decay_rate: np.ndarray  # (*shape,) sigma_b = -max Re lambda over the base group, 1/s
+    base_decay_rate: np.ndarray  # (*shape,) sigma_b: the deflection's decay as it passes 10 % (growing: -max Re)
     arm_decay_rate: np.ndarray  # (*shape,) sigma_a over the arm group (nan if the group is empty), 1/s
-    base_damping_ratio: np.ndarray  # (*shape,) -Re/|lambda| of the slowest base pole (1 if real)
-    base_frequency: np.ndarray  # (*shape,) |Im lambda| of the slowest base pole, rad/s
+    base_damping_ratio: np.ndarray  # (*shape,) -Re/|lambda| of the pole that dominates at 10 % (1 if real)
+    base_frequency: np.ndarray  # (*shape,) |Im lambda| of that pole, rad/s
     stable: np.ndarray  # (*shape,) bool: every kept mode decays (rate > STABLE_MARGIN)
+    base_time_to_10pct: np.ndarray  # (*shape,) s after the kick's end until |x_b| stays under 10 % of its peak
+    peak: np.ndarray  # (*shape,) the kick's peak deflection, m (rad on a rotation)
+    swing: np.ndarray  # (*shape,) rad: the joints' largest swing outside the RNS while absorbing the kick
+    reason: np.ndarray  # (*shape,) int: why the prediction is not kept (kick.REASONS; 0: kept)
 
     @property
-    def base_time_to_10pct(self) -> np.ndarray:
-        """ln 10 / sigma_b, s (inf where the base does not decay)."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.base_decay_rate > 0, LN10 / self.base_decay_rate, np.inf)
+    def predictable(self) -> np.ndarray:
+        """Stable and the linear loop speaks for the kick's run (``reason`` 0)."""
+        return self.stable & (self.reason == KEPT)
 
     @property
     def arm_time_to_10pct(self) -> np.ndarray:
@@ -48,9 +59,15 @@ class Modes:
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(self.arm_decay_rate > 0, LN10 / self.arm_decay_rate, np.inf)
 
+    def why_not(self, index: tuple[int, ...] = ()) -> str:
+        """Why the prediction at ``index`` is not kept, in words ('' if it is; 'unstable' if it grows)."""
+        if not bool(self.stable[index]):
+            return "the loop is unstable"
+        return reason_text(int(self.reason[index]), float(self.swing[index]))
+
 
 def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray) -> Modes:
-    """Poles and their base/arm grouping at gains (1/s) that broadcast together.
+    """Poles, the kick response and the base/arm grouping at gains (1/s) that broadcast together.
 
     In ``loop.basis`` A is block triangular: eigenvectors are needed only for the block x_b can
     show (the last ``loop.seen`` states); the other block's poles have no share in x_b.
@@ -63,21 +80,50 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     shape = np.broadcast_shapes(gb.shape, gm.shape)[:-2]
     A = (blocks[0] + gb * blocks[1] + gm * blocks[2]).reshape(-1, d, d)
     mu, V = np.linalg.eig(A[:, k:, k:])
-    try:
-        W = np.linalg.inv(V)  # rows are the left eigenvectors, scaled so that W V = E
+    kick = loop.kick
+    observed = T[:, k:]
+    C_y = kick.output @ observed[np.flatnonzero(loop.kept < loop.m)]  # (seen,): y on the observable block
+    C_L = loop.coupling @ loop.joint_rates @ observed  # (r, seen): L = S H_bm theta'
+    b = observed.T @ loop.force_input @ kick.weights
+    try:  # (K, seen): w_i^H B d, the left eigenvectors scaled so that W V = E
+        forcing = np.linalg.solve(V, np.broadcast_to(b, (len(V), len(b)))[..., None])[..., 0]
     except np.linalg.LinAlgError:  # a defective pole somewhere in the batch (V singular there)
-        W = np.linalg.pinv(V)
-    C = T[np.flatnonzero(loop.kept < loop.m)][:, k:]  # (m, seen): x_b on the observable block
-    B = (T.T @ loop.impulse_input())[k:]  # (seen, m); C (sI - A)^-1 B involves this block only
-    residue = np.linalg.norm(C @ V, axis=1) * np.linalg.norm(W @ B, axis=2)  # ||C v_i|| ||w_i^H B||
-    share = residue / np.maximum(residue.sum(axis=1, keepdims=True), 1e-300)
+        forcing = np.linalg.pinv(V) @ b
+    y_gain = (C_y @ V) * forcing  # (K, seen)
+    seen = loop.rates(mu)
     hidden = _hidden_poles(blocks, k, np.broadcast_to(gb, (*shape, 1, 1)), np.broadcast_to(gm, (*shape, 1, 1)))
-    lam = loop.rates(np.concatenate((hidden, mu), axis=1))
-    share = np.concatenate((np.zeros(hidden.shape), share), axis=1)
-    is_base = share >= BASE_SHARE
+    lam = np.concatenate((loop.rates(hidden), seen), axis=1)
     re = lam.real
+    stable = -re.max(axis=1) > STABLE_MARGIN
+    count = len(stable)
+
+    # Every mode's envelope after the kick, then the response where the loop is stable.
+    steps = pulse_steps(kick, loop.dt)
+    discrete = mu if loop.view == "discrete" else None
+    after = kick.peak * y_gain * pulse_states(seen, discrete, loop.dt, kick.duration, steps[-1:])[..., 0]
+    pair = np.abs(fold_pairs(seen, after))
+    pair = np.where(seen.imag < 0, np.abs(2 * after), pair)  # the lower pole shows its pair's amplitude too
+    amplitude = np.concatenate((np.zeros(hidden.shape), pair), axis=1)
+    peak, settle, swing = (np.full(count, np.nan) for _ in range(3))
+    reason = np.full(count, KEPT)
+    base_rate = np.full(count, np.nan)
+    dominant = np.zeros(count, dtype=int)
+    if stable.any():
+        rows = np.flatnonzero(stable)
+        resp = _respond(loop, seen[rows], None if discrete is None else mu[rows], V[rows], forcing[rows],
+                        y_gain[rows], C_L, steps)  # fmt: skip
+        peak[rows], settle[rows], swing[rows], reason[rows] = resp.peak, resp.settle_time, resp.swing, resp.reason
+        base_rate[rows] = resp.decay_rate
+        dominant[rows] = k + resp.dominant
+    scale = np.where(stable, peak, amplitude.max(axis=1))
+    share = amplitude / np.maximum(scale, 1e-300)[:, None]
+    # a growing mode the base shows at all takes over in the end
+    is_base = np.where(stable[:, None], share >= BASE_SHARE, share > UNSTABLE_SHARE)
+    is_base[np.arange(count), dominant] |= stable
     slowest = np.argmax(np.where(is_base, re, -np.inf), axis=1)
-    s = np.take_along_axis(lam, slowest[:, None], axis=1)[:, 0]
+    dominant = np.where(stable, dominant, slowest)
+    base_rate = np.where(stable, base_rate, -re[np.arange(count), slowest])
+    s = lam[np.arange(count), dominant]
     arm_rate = np.where(is_base.all(axis=1), np.nan, -np.where(is_base, -np.inf, re).max(axis=1))
     with np.errstate(divide="ignore", invalid="ignore"):
         zeta = np.where(np.abs(s) > 0, -s.real / np.abs(s), 1.0)
@@ -85,12 +131,70 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
         poles=lam.reshape(*shape, d),
         base_share=share.reshape(*shape, d),
         is_base=is_base.reshape(*shape, d),
-        base_decay_rate=(-s.real).reshape(shape),
+        base_decay_rate=base_rate.reshape(shape),
         arm_decay_rate=arm_rate.reshape(shape),
         base_damping_ratio=zeta.reshape(shape),
         base_frequency=np.abs(s.imag).reshape(shape),
-        stable=(-re.max(axis=1) > STABLE_MARGIN).reshape(shape),
+        stable=stable.reshape(shape),
+        base_time_to_10pct=np.where(stable, settle, np.inf).reshape(shape),
+        peak=peak.reshape(shape),
+        swing=swing.reshape(shape),
+        reason=reason.reshape(shape),
     )
+
+
+def _respond(
+    loop: LinearLoop,
+    lam: np.ndarray,
+    mu: np.ndarray | None,
+    V: np.ndarray,
+    forcing: np.ndarray,
+    y_gain: np.ndarray,
+    C_L: np.ndarray,
+    steps: np.ndarray,
+) -> KickResponse:
+    """The kick's response at K stable loops from their observable modes (lam, mu, V, forcing, y_gain: (K, s)
+    or (K, s, s)); its ``dominant`` indexes these modes.
+
+    Through the push every mode counts (fast ones too: they cancel slower ones while it lasts); after it,
+    :func:`~rns_viz.analysis.kick.respond` follows the modes with a part in y or in the integral of L (a
+    pair's on its upper pole, the lower goes) of at least KEPT_PART of the largest: modes that cancel each
+    other stay together. The loops go in two batches by how many modes they need (each batch is padded to
+    its largest, with parts 0).
+    """
+    kick = loop.kick
+    xi = pulse_states(lam, mu, loop.dt, kick.duration, steps)  # (K, s, J) through the push
+    L_gain = (C_L @ V) * forcing[:, None, :]  # (K, r, s)
+    y_pulse = kick.peak * np.einsum("ks,ksj->kj", y_gain, xi).real
+    L_pulse = kick.peak * np.einsum("krs,ksj->krj", L_gain, xi).real
+    a, a_L = kick.peak * y_gain * xi[..., -1], kick.peak * L_gain * xi[:, None, :, -1]
+    part = np.abs(fold_pairs(lam, a))
+    part_L = np.linalg.norm(fold_pairs(lam, a_L), axis=1) / np.abs(lam)
+    with np.errstate(invalid="ignore"):
+        part = np.nan_to_num(part / part.max(axis=1, keepdims=True) + part_L / part_L.max(axis=1, keepdims=True))
+    needed = np.maximum((part >= KEPT_PART).sum(axis=1), 1)
+    order = np.argsort(-part, axis=1)
+    split = int(np.percentile(needed, 80))
+    out = [np.empty(len(lam)) for _ in range(4)]
+    reason, dominant = np.empty(len(lam), dtype=int), np.empty(len(lam), dtype=int)
+    for rows in (np.flatnonzero(needed <= split), np.flatnonzero(needed > split)):
+        if len(rows) == 0:
+            continue
+        take = order[rows, : int(needed[rows].max())]
+        real = np.take_along_axis(part[rows], take, 1) >= KEPT_PART  # the batch's padding counts 0
+        lam_p, a_p, a_L_p = (_modes(x[rows], take) for x in (lam, a, a_L))
+        got = respond(lam_p, a_p * real, a_L_p * real[:, None, :], y_pulse[rows], L_pulse[rows], loop.swing_map,
+                      steps * loop.dt, loop.joint_margins)  # fmt: skip
+        for store, value in zip(out, (got.peak, got.settle_time, got.decay_rate, got.swing), strict=True):
+            store[rows] = value
+        reason[rows] = got.reason
+        dominant[rows] = np.take_along_axis(take, got.dominant[:, None], 1)[:, 0]
+    return KickResponse(*out[:3], dominant, out[3], reason)
+
+
+def _modes(x: np.ndarray, take: np.ndarray) -> np.ndarray:
+    """The modes ``take`` (K, p) of x (K, s) or (K, r, s)."""
+    return np.take_along_axis(x, take if x.ndim == 2 else take[:, None, :], axis=-1)
 
 
 def _hidden_poles(blocks: list[np.ndarray], k: int, gb: np.ndarray, gm: np.ndarray) -> np.ndarray:

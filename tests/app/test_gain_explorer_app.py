@@ -10,6 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from rns_viz.defaults import defaults_for
 from rns_viz.viz.panels.gain_panel import QUANTITIES, GainExplorerView, locus_data
 from rns_viz.viz.scene.gain_scene import GainScene, axis_fraction, colours, grid_point, map_image
 from rns_viz.viz.server.app import RnsApp, start_app
@@ -217,7 +218,7 @@ def test_map_image_marks_unstable_cells_and_clicks_map_to_cells(app: RnsApp) -> 
     i, j = np.argwhere(~gm.stable)[0]
     cell = image[(G - 1 - j) * 4 : (G - j) * 4, i * 4 : (i + 1) * 4]
     assert {tuple(p) for p in cell.reshape(-1, 3)} <= {(90, 90, 90), (200, 200, 200)}
-    rates = np.where(gm.stable, gm.base_decay_rate, np.nan)
+    rates = np.where(gm.predictable, gm.base_decay_rate, np.nan)  # the cells drawn in the legend's colours
     for k in (np.nanargmax(rates), np.nanargmin(rates)):
         i, j = np.unravel_index(k, rates.shape)
         want = colours(gm.base_decay_rate[i, j], scale)
@@ -242,10 +243,18 @@ def test_panel_states_the_views_and_the_loci_split_base_and_arm(app: RnsApp) -> 
 
 def test_after_a_kick_the_panel_sets_the_measured_decay_beside_the_prediction(app: RnsApp) -> None:
     s, ex = app.session, explorer(app)
-    s.kick(0.8 if app.model_name == "trep" else 5.0)  # N, the kick slider's default
-    s.advance(9.0)  # the first fit comes 4 s after the kick, then every second
-    measured = s.gain_view().measured
+    start = defaults_for(app.model_name).gains_for(s.gain_view().law)  # an earlier test may have clicked a cell
+    s.set_gains(g_b=start.g_b, g_m=start.g_m)
+    s.advance(0.01)
+    assert s.wait_background()
+    s.kick(defaults_for(app.model_name).kick_peak_N)  # the kick slider's default
+    for _ in range(20):  # read from 4 s after the kick, every second, until it is under 10 % of its peak
+        s.advance(1.0)
+        measured = s.gain_view().measured
+        if measured is not None and np.isfinite(measured.rate):
+            break
     assert measured is not None and np.isfinite(measured.rate)
+    assert measured.settle_time == pytest.approx(float(s.gain_view().current.base_time_to_10pct), rel=0.05)
     # The render thread may first show an earlier fit (one a second after the kick): wait for the last one.
     shown = f"{measured.rate:.3g} 1/s"
     wait_until(lambda: shown in ex.predicted.content, 10.0, "the panel to show the last measured decay")

@@ -1,15 +1,18 @@
 """The live gain explorer: the map, loci and authority for the law in force, updated by the gain
-sliders, and after a kick the measured decay of x_b beside the prediction (within 10 %)."""
+sliders, after a kick the measured decay of x_b beside the prediction (within 10 %), and the panel's
+reason where the map cannot predict."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from rns_viz.analysis import modes_of
 from rns_viz.live.loop.session import Session
+from rns_viz.viz.panels.gain_panel import predicted_text
 
 
-@pytest.mark.parametrize(("model", "kick_n", "seconds"), [("trep", 0.8, 10.0), ("planar3r", 5.0, 16.0)])
+@pytest.mark.parametrize(("model", "kick_n", "seconds"), [("trep", 0.8, 13.0), ("planar3r", 5.0, 16.0)])
 def test_prediction_matches_the_measured_decay(model: str, kick_n: float, seconds: float) -> None:
     s = Session(model, realtime=False)
     try:
@@ -46,5 +49,21 @@ def test_the_views_follow_the_gains_and_the_law() -> None:
         assert s.wait_background()
         view = s.gain_view()
         assert view.law == "acceleration" and view.map is not None and "(15)" in view.g_m_meaning
+    finally:
+        s.stop()
+
+
+def test_the_panel_says_why_a_cell_is_not_predictable() -> None:
+    s = Session("planar3r", realtime=False)
+    try:
+        assert s.wait_background()
+        s.set_gains(g_b=3.29, g_m=0.1)
+        s.advance(0.01)
+        assert s.wait_background()
+        view = s.gain_view()
+        now = modes_of(view.map.loop, 3.29, 0.1)
+        assert not bool(now.predictable)
+        text = predicted_text(view)
+        assert "not predictable" in text and now.why_not() in text and "5 N, 0.2 s kick along x" in text
     finally:
         s.stop()

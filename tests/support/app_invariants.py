@@ -80,8 +80,10 @@ def _gain_view_violations(app: RnsApp) -> list[str]:
     if m is not None:
         if (m.model, m.law, m.gains, m.epoch) != (st.model, st.law, g, snap.epoch):
             out.append(f"measured on {(m.model, m.law, m.gains, m.epoch)} shown in {(st.model, st.law, g, snap.epoch)}")
-        if not (0.0 <= m.since <= snap.t and math.isfinite(m.rate)):
+        if not 0.0 <= m.since <= snap.t:
             out.append(f"measured after a kick at t = {m.since} s in a run at t = {snap.t} s")
+        if math.isfinite(m.rate) != math.isfinite(m.settle_time):  # a rate only once under 10 % (ln 10 / time)
+            out.append(f"measured rate {m.rate} 1/s with time to 10 % {m.settle_time} s")
     return out
 
 

@@ -4,7 +4,8 @@ For the law and configuration in force, a background thread linearises the close
 (:mod:`rns_viz.analysis`, the simulator's own 1 ms step map, in a helper process) and derives the
 g_b x g_m map of decay rates, the root loci through the current gains and the predicted decay along
 the current reactionless path (TREP) or over the reactionless-reachable set (3R). After a kick the
-loop fits the decay of the measured base deflection, to set beside the prediction.
+loop measures the base deflection along the kick as the map predicts it (time to 10 % of its peak,
+decay there), to set beside the prediction.
 
 The loop calls :meth:`GainExplorer.context`, :meth:`retune`, :meth:`along`, :meth:`kicked` and
 :meth:`measure`; :meth:`collect` takes finished results. Readers take :attr:`GainExplorer.view`.
@@ -32,7 +33,7 @@ from rns_viz.analysis import (
     Locus,
     Modes,
     authority,
-    fit_decay,
+    measure_kick,
     modes_of,
     root_locus,
 )
@@ -44,21 +45,23 @@ from rns_viz.sim import Simulator
 
 AUTHORITY_POINTS = 80  # configurations along the path / over the set where the decay is predicted
 AUTHORITY_CHUNK = 10  # configurations per helper call: other jobs (a new reachable set) go between calls
-FIT_FIRST_S = 4.0  # s after a kick before the first fit of the measured decay ...
+FIT_FIRST_S = 4.0  # s after a kick before the measured deflection is first read ...
 FIT_EVERY_S = 1.0  # ... and then every this many seconds ...
 FIT_UNTIL_S = 20.0  # ... until this long after it
 
 
 @dataclass(frozen=True)
 class Measured:
-    """The decay of the measured base deflection after the last kick, and what it was measured on."""
+    """The measured base deflection along the last kick (rns_viz.analysis.measure_kick), and what it was
+    measured on."""
 
-    rate: float  # 1/s, fitted to the peaks of |x_b|
+    rate: float  # 1/s, ln 10 / settle_time (nan: not under 10 % yet)
     since: float  # s, the kick's time
-    seconds: float  # s of log fitted
+    seconds: float  # s of log read
+    settle_time: float  # s after the kick's end until |y| stays under 10 % of its peak (inf: not yet)
     model: str  # the model key
     law: LawKind
-    gains: Gains  # in force from the kick to the end of the fit
+    gains: Gains  # in force from the kick to the end of the log read
     epoch: int  # the loop's epoch (a reset, model switch or preset starts another)
 
 
@@ -94,7 +97,9 @@ class GainExplorer:
         self._loop: LinearLoop | None = None
         self._loops: list[LinearLoop] | None = None
         self._key: tuple[str, LawKind, bytes] | None = None
-        self.kick_t = math.nan  # s, the last kick (nan: no fit due)
+        self.kick_t = math.nan  # s, the last kick (nan: no measurement due)
+        self._kick_end = math.nan  # s
+        self._kick_output = np.ones(1)  # y = this . x_b: the deflection along the last kick
         self._next_fit = math.inf
         self.view = GainView(0, -1, "", "velocity", Gains(), "", None, None, None, None, (), None, None, None)
 
@@ -174,12 +179,15 @@ class GainExplorer:
 
         self.worker.submit("along", key, job)
 
-    def kicked(self, t: float, suppress: bool) -> None:
-        """A kick at ``t``: fit its decay from FIT_FIRST_S on, if the operated run suppresses (the
-        prediction is of the suppressing law; without suppression there is nothing to compare)."""
+    def kicked(self, t: float, duration: float, direction: tuple[float, ...] | None, suppress: bool) -> None:
+        """A kick started at t (s), lasting ``duration`` s along ``direction`` (None: the first base
+        coordinate): read it from FIT_FIRST_S on, if the operated run suppresses (the prediction is of the
+        suppressing law; without suppression there is nothing to compare)."""
         self._forget_kick()
         if suppress:
-            self.kick_t, self._next_fit = t, t + FIT_FIRST_S
+            self.kick_t, self._next_fit, self._kick_end = t, t + FIT_FIRST_S, t + duration
+            w = np.asarray(direction if direction is not None and np.any(direction) else (1.0,), dtype=float)
+            self._kick_output = w / float(w @ w)
         self._publish(measured=None)
 
     def forget_measurement(self) -> None:
@@ -195,18 +203,19 @@ class GainExplorer:
         return t >= self._next_fit
 
     def measure(self, sim: Simulator) -> None:
-        """Fit the decay since the last kick to the operated run's log of x_b; call when :meth:`fit_due`."""
+        """Read the deflection along the last kick from the operated run's log; call when :meth:`fit_due`."""
         t, log = sim.t, sim.log
         self._next_fit = t + FIT_EVERY_S if t < self.kick_t + FIT_UNTIL_S else math.inf
         rows = min(len(log), round((t - self.kick_t) / sim.dt) + 1)
-        times, x_b = log.column("t", rows), log.column("xb_1", rows)  # the first base coordinate
-        try:
-            fit = fit_decay(times, x_b, start=self.kick_t)
-        except ValueError:
-            return  # too few swings yet
+        times = log.column("t", rows)
+        y = sum(w * log.column(f"xb_{i + 1}", rows) for i, w in enumerate(self._kick_output) if w)
+        if rows < 3 or not np.any(y):
+            return
+        got = measure_kick(times, y, self._kick_end)
         v = self.view
         seconds = float(times[-1] - self.kick_t)
-        self._publish(measured=Measured(fit.rate, self.kick_t, seconds, v.model, v.law, v.gains, v.epoch))
+        measured = Measured(got.decay_rate, self.kick_t, seconds, got.settle_time, v.model, v.law, v.gains, v.epoch)
+        self._publish(measured=measured)
 
     # -- results -----------------------------------------------------------------------------------
     def collect(self) -> bool:

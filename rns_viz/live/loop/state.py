@@ -203,7 +203,7 @@ class LiveState:
                 duration = defaults_for(self.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m, direction))
                 self.kicks_sent += 1
-                self.explorer.kicked(self.runs.t, st.suppress)
+                self.explorer.kicked(self.runs.t, duration, direction, st.suppress)
             case c.SetSuppression(on=on):
                 self.runs.set_suppression(on)
                 if on != st.suppress:  # the runs swap roles: both, and the plots, restart from here

@@ -99,8 +99,8 @@ class BasePanel:
         """The shown model's base coordinates."""
         return len(self.turns)
 
-    def for_model(self, model: FsmsModel) -> None:
-        """Show the panel for ``model`` (hidden for a 1-DOF base), the kick first along its ``[app] kick_axis``."""
+    def for_model(self, model: FsmsModel, default_axis: int | None = None) -> None:
+        """Show the panel for ``model`` (hidden for a 1-DOF base)."""
         self.turns = model.base_rotational
         self.folder.visible = model.m > 1
         if model.m == 1:
@@ -108,7 +108,8 @@ class BasePanel:
         names = coordinate_names(model)
         with self.controls.quiet():
             self.direction.options = (*(n.split(" ")[0] for n in names), ALL)
-        self.controls.show(self.direction, self.direction.options[defaults_for(model).kick_axis])
+        axis = defaults_for(model).kick_axis if default_axis is None else default_axis  # the gain map's kick
+        self.controls.show(self.direction, self.direction.options[min(axis, model.m - 1)])
         for i, box in enumerate(self.boxes):
             box.visible = i < model.m
             if i < model.m:

@@ -23,12 +23,12 @@ from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.control_panel import GAIN_SLIDERS, GuiElements
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.model_menu import label_of
-from rns_viz.viz.scene.gain_scene import LN10, GainScene, Quantity
+from rns_viz.viz.scene.gain_scene import GainScene, Quantity
 from rns_viz.viz.scene.style import SceneStyle
 
 QUANTITIES: dict[str, Quantity] = {
-    "base mode σ_b (1/s)": "base",
-    "base mode time to 10 % (s)": "time",
+    "base decay σ_b (1/s)": "base",
+    "base time to 10 % (s)": "time",
     "arm mode σ_a (1/s)": "arm",
 }
 RIGHT = 0.15  # the locus plots show Re λ up to this fraction of their left reach (unstable poles)
@@ -91,15 +91,15 @@ class GainExplorerView:
         ) as self.folder:  # above Download
             g.add_markdown(
                 "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
-                "(g_b, g_m) setting, coloured by "
-                "how fast the closed loop, linearised about the current pose, damps the chosen mode. "
-                "**Click a cell** to apply its gains."
+                "(g_b, g_m) setting, coloured by how fast the closed loop, linearised about the current pose, damps a "
+                "kick (the one in the map's title; faded, hatched cells: it cannot say). **Click a cell** to apply its gains."
             )
             self.quantity = g.add_dropdown(
                 "Map shows",
                 tuple(QUANTITIES),
                 initial_value=next(iter(QUANTITIES)),
-                hint="Base mode: the poles a base kick excites; arm mode: the others (Sec. VIII: two subsystems).",
+                hint="Base: how a kick decays, σ_b = ln 10 / the time it takes to fall to 10 % of its peak; arm "
+                "mode: the slowest pole a kick hardly shows (Sec. VIII: two subsystems).",
             )
             self.meaning = g.add_markdown("")
             self.predicted = g.add_markdown("")
@@ -263,23 +263,44 @@ def _fmt_rate(rate: float) -> str:
         return "…"
     if rate <= 0:
         return f"{rate:.3g} 1/s (grows)"
-    return f"{rate:.3g} 1/s, 10 % in {LN10 / rate:.3g} s"
+    return f"{rate:.3g} 1/s"
+
+
+def _fmt_time(seconds: float) -> str:
+    return f"10 % in {seconds:.3g} s after the kick" if math.isfinite(seconds) else "not under 10 % yet"
+
+
+def _prediction(view: GainView) -> str:
+    """The predicted decay at the gains in force, or why there is none."""
+    now = view.current
+    if now is None:
+        return "…"
+    if not bool(now.stable):
+        return f"none: the loop is unstable (σ_b {_fmt_rate(float(now.base_decay_rate))})"
+    why = now.why_not()
+    if why:
+        return f"**not predictable**: {why}"
+    return f"σ_b {_fmt_rate(float(now.base_decay_rate))}, {_fmt_time(float(now.base_time_to_10pct))}"
 
 
 def predicted_text(view: GainView) -> str:
-    """One line: predicted base decay at the gains in force, and after a kick the measured one, naming what
-    it measured (model, gains, kick); only a measurement of the view's model, law, gains and run is shown."""
+    """One line: the predicted base decay at the gains in force (or why there is none), for which kick, and
+    after a kick the measured one, naming what it measured (model, gains, kick); only a measurement of the
+    view's model, law, gains and run is shown."""
     gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
     if view.analysed:
-        pred = f"**Base decay** at {gains}: predicted {_fmt_rate(view.predicted)}"
+        pred = f"**Base decay** at {gains}: predicted {_prediction(view)}"
+        if view.map is not None and view.current is not None and bool(view.current.stable):
+            pred += f" ({view.map.loop.regime}; the arm swings {float(view.current.swing):.2g} rad)"
     else:
         pred = f"**Base decay** at {gains}: not predicted for this model (no linearisation of its compensating law)"
     m = view.measured
     if m is None or (m.model, m.law, m.gains, m.epoch) != (view.model, view.law, view.gains, view.epoch):
-        return f"{pred}; *kick the base with suppression on to measure it* (fit of the |x_b| peaks, 4–20 s after)."
+        return f"{pred}; *kick the base with suppression on to measure it* (read 4–20 s after the kick)."
     what = f"{label_of(m.model)}, g_b = {m.gains.g_b:.4g}, g_m = {m.gains.g_m:.4g} 1/s"
-    fit = f"fit over {m.seconds:.1f} s after the kick at t = {m.since:.1f} s"
-    return f"{pred}; **measured** {_fmt_rate(m.rate)} ({what}, {fit})."
+    rate = f", σ {_fmt_rate(m.rate)}" if math.isfinite(m.rate) else ""
+    read = f"{m.seconds:.1f} s of log after the kick at t = {m.since:.1f} s"
+    return f"{pred}; **measured** {_fmt_time(m.settle_time)}{rate} ({what}, {read})."
 
 
 def authority_text(view: GainView, on_path: bool) -> str:

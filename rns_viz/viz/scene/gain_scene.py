@@ -2,9 +2,11 @@
 
 The map is an image standing beside the robot, facing the model's initial camera: g_b (1/s, log)
 to the right, g_m (1/s, log) upwards, each grid cell coloured by a decay rate (1/s, log colour
-scale), unstable cells hatched grey. A click arrives as a ray (viser's scene click); it is met with
-the map's plane and turned into the nearest grid point (:func:`grid_point`). The authority along
-the current path (TREP) or over the reachable set (3R) is drawn under ``/base`` in the same colours.
+scale), unstable cells hatched grey, cells whose prediction the linear loop cannot make for the
+map's kick faded and hatched the other way (the panel says why). A click arrives as a ray (viser's
+scene click); it is met with the map's plane and turned into the nearest grid point
+(:func:`grid_point`). The authority along the current path (TREP) or over the reachable set (3R) is
+drawn under ``/base`` in the same colours.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ LN10 = math.log(10.0)
 CELL_PIXELS = 4  # image pixels per grid cell (the hatching of unstable cells needs a few)
 UNSTABLE_RGB = (90, 90, 90)  # hatched with UNSTABLE_HATCH
 UNSTABLE_HATCH = (200, 200, 200)
+UNPREDICTABLE_FADE = 0.6  # a not-predictable cell's colour is mixed this much with white ...
+UNPREDICTABLE_HATCH = (110, 110, 110)  # ... and hatched the other way in this
 MISSING_RGB = (235, 235, 235)  # no such mode (an empty arm group)
 NOW_COLOUR = (255, 255, 255)
 # viser's client turns an image's plane by pi about x, so its back faces the camera, and the outline it
@@ -63,7 +67,11 @@ def colour_scale(rates: np.ndarray, stable: np.ndarray) -> tuple[float, float]:
 
 
 def map_rates(gain_map: GainMap, quantity: Quantity) -> np.ndarray:
-    """The (B, G) rates (1/s) a map view colours: the base mode's (also for its time to 10 %) or the arm's."""
+    """The (B, G) rates (1/s) a map view colours: the base mode's, ln 10 over its time to 10 % (so that
+    fast is yellow in every view), or the arm's."""
+    if quantity == "time":
+        with np.errstate(divide="ignore"):
+            return LN10 / gain_map.base_time_to_10pct
     return gain_map.arm_decay_rate if quantity == "arm" else gain_map.base_decay_rate
 
 
@@ -71,7 +79,7 @@ def map_image(gain_map: GainMap, quantity: Quantity) -> tuple[np.ndarray, tuple[
     """RGB image (G*CELL_PIXELS, B*CELL_PIXELS, 3) of the map and its colour scale: column = g_b (left to
     right), row = g_m (row 0 the highest), as :class:`GainScene` shows it (g_b right, g_m up)."""
     rates = map_rates(gain_map, quantity)
-    scale = colour_scale(rates, gain_map.stable)
+    scale = colour_scale(rates, gain_map.predictable)  # over the cells drawn in the legend's colours
     rgb = colours(rates, scale)  # (B, G, 3)
     rgb[~np.isfinite(rates)] = MISSING_RGB
     hatch = np.zeros((CELL_PIXELS, CELL_PIXELS), dtype=bool)
@@ -83,7 +91,21 @@ def map_image(gain_map: GainMap, quantity: Quantity) -> tuple[np.ndarray, tuple[
     stripes = np.tile(hatch, (gain_map.g_m.size, gain_map.g_b.size))
     cells[bad] = UNSTABLE_RGB
     cells[bad & stripes] = UNSTABLE_HATCH
+    mark_unpredictable(cells, np.repeat(np.repeat(not_predictable(gain_map).T[::-1], CELL_PIXELS, 0), CELL_PIXELS, 1))
     return cells, scale
+
+
+def not_predictable(gain_map: GainMap) -> np.ndarray:
+    """(B, G) bool: stable cells whose prediction the linear loop cannot make for the map's kick."""
+    return gain_map.stable & ~gain_map.predictable
+
+
+def mark_unpredictable(pixels: np.ndarray, where: np.ndarray) -> None:
+    """Fade the colour of the pixels ``where`` (an image-shaped mask) and hatch them along the other diagonal."""
+    faded = pixels[where] * (1 - UNPREDICTABLE_FADE) + 255 * UNPREDICTABLE_FADE
+    pixels[where] = np.round(faded).astype(np.uint8)
+    rows, cols = np.indices(where.shape)
+    pixels[where & ((rows - cols) % CELL_PIXELS == 0)] = UNPREDICTABLE_HATCH
 
 
 def axis_fraction(axis: np.ndarray, value: float) -> float:
@@ -182,7 +204,7 @@ class GainScene:
             self.gain_map = None
             return
         image, self.scale = map_image(gm, quantity)
-        self.base_scale = colour_scale(gm.base_decay_rate, gm.stable)  # the authority's, whatever is shown
+        self.base_scale = colour_scale(gm.base_decay_rate, gm.predictable)  # the authority's, whatever is shown
         new_axes = self.gain_map is None or not (
             np.array_equal(gm.g_b, self.gain_map.g_b) and np.array_equal(gm.g_m, self.gain_map.g_m)
         )
@@ -327,11 +349,12 @@ def _decades(axis: np.ndarray) -> list[float]:
 
 def _title(view: GainView, quantity: Quantity) -> str:
     what = {
-        "base": "base mode decay rate σ_b (1/s)",
-        "time": "base mode time to 10 % (s)",
+        "base": "base decay rate σ_b (1/s)",
+        "time": "base time to 10 % of its peak (s)",
         "arm": "arm mode decay rate σ_a (1/s)",
     }[quantity]
-    return f"Gain map, law {_law_eq(view)}: {what} — click a cell to apply its gains"
+    regime = f" {view.map.loop.regime}" if view.map is not None else ""
+    return f"Gain map, law {_law_eq(view)}{regime}: {what} — click a cell to apply its gains"
 
 
 def _legend(quantity: Quantity, scale: tuple[float, float]) -> str:
@@ -341,7 +364,8 @@ def _legend(quantity: Quantity, scale: tuple[float, float]) -> str:
     else:
         sym = "σ_a" if quantity == "arm" else "σ_b"
         span = f"{sym}: dark {lo:.3g} … yellow {hi:.3g} 1/s (log)"
-    return f"{span}; hatched grey: unstable; white: now; black: paper"
+    marks = "hatched grey: unstable; faded, hatched \\: not predictable for this kick (the panel says why)"
+    return f"{span}; {marks}; white: now; black: paper"
 
 
 def _law_eq(view: GainView) -> str:
