@@ -92,7 +92,8 @@ class GainExplorerView:
             g.add_markdown(
                 "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
                 "(g_b, g_m) setting, coloured by how fast the closed loop, linearised about the current pose, damps a "
-                "kick (the one in the map's title; faded, hatched cells: it cannot say). **Click a cell** to apply its gains."
+                "kick (the one in the map's title; faded, hatched cells: it cannot say). "
+                "**Click a cell** to apply its gains."
             )
             self.quantity = g.add_dropdown(
                 "Map shows",
