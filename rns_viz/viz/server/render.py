@@ -35,7 +35,7 @@ from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
-from rns_viz.viz.scene.view_toggles import ViewToggles
+from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
@@ -149,7 +149,7 @@ class Renderer:
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
         kept = {name for name in KEPT_ACROSS_MODELS if self.view.on(name)}  # the viewer's choice, not the model's
-        self.view.show_only(defaults.shown | kept)  # the new model's first look
+        self.view.show_only(first_look(self.model) | kept)  # the new model's first look
         self._seen = _Seen()
         self.sync_settings(snap)
         self.model_name = snap.settings.model
@@ -221,7 +221,7 @@ class Renderer:
         if paths != seen.paths:
             seen.paths = paths
             seen.overlay_version = -1  # redrawn with or without the family
-        self.explorer.show(view.on("gain_map"))
+        self.explorer.show(view.on("gain_map"), self.scene)
 
     def _draw_state(self, snap: Snapshot) -> None:
         """The arm, the base and the reaction arrow, when what a viewer sees changed."""
