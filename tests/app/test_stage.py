@@ -10,14 +10,16 @@ import numpy as np
 import pytest
 
 from rns_viz.defaults import defaults_for
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.reach.region import arm_reach
+from rns_viz.model import FsmsModel
 from rns_viz.param_file import Overlay
 from rns_viz.params import MODEL_NAMES, missing_extra
 from rns_viz.viz.panels.glossary import KEYS
 from rns_viz.viz.panels.keys import jog_step
 from rns_viz.viz.scene.framing import frame_points
 from rns_viz.viz.scene.fsms_scene import FsmsScene
-from rns_viz.viz.scene.view_toggles import TOGGLES
+from rns_viz.viz.scene.view_toggles import TOGGLES, first_look
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.app_helpers import stepped_app
 from tests.support.browser import wait_for_clients, wait_until
@@ -115,6 +117,16 @@ def test_first_look_table_names_only_real_toggles_and_starts_calm() -> None:
             assert "gain_map" not in shown and "paths" not in shown, model  # the calm default
     assert defaults_for("trep").shown == {"ghost", "reaction", "trail", "labels", "path_arrows"}
     assert defaults_for("planar3r").shown == {"ghost", "reaction", "trail", "labels", "reach"}
+
+
+@pytest.mark.parametrize(("key", "reach"), [("trep", False), ("boom7", False), ("boom7#S=111000", True)])
+def test_the_first_look_shows_the_reachable_set_the_target_is_dragged_over(key: str, reach: bool) -> None:
+    """An operator that drives a target over the reactionless-reachable set (boom7 holding forces only: a
+    4-D reaction null space) shows that set from the first look; one that follows a path adds nothing."""
+    model = FsmsModel.from_key(key)
+    assert (operator_class(model).shows == "reachable set") == reach
+    assert first_look(model) == (defaults_for(model).shown | ({"reach"} if reach else set()))
+    assert ("reach" in first_look(model)) == (reach or "reach" in defaults_for(model).shown)
 
 
 @pytest.mark.parametrize("model", ["trep", "boom7"])

@@ -1,8 +1,8 @@
 """Words on screen that must be true: controls named by the lessons exist under those names and are not
 disabled when a lesson names them, and one quantity has one notation everywhere it is shown.
 
-Lessons name a control in *italics*, exactly as the panel labels it (a folder may be named without its
-parenthesis: *Live plots* for 'Live plots (last 10 s)')."""
+Lessons name a control in *italics*, exactly as the panel labels it (a folder or tab may be named without
+its parenthesis: *Live plots* for the tab 'Live plots (last 10 s)')."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def app() -> Iterator[RnsApp]:
 
 
 def controls(app: RnsApp) -> dict[str, list[Any]]:
-    """Every name a person can find in the panel -> the controls of that name: labels of buttons, boxes,
+    """Every name a person can find in the panels -> the controls of that name: labels of buttons, boxes,
     dropdowns, folders and tabs (also without a trailing parenthesis), and the options of button groups."""
     gui = app.server.gui
     names: dict[str, list[Any]] = {}

@@ -30,6 +30,7 @@ from tests.support.browser import (
     ARTIFACTS,
     browser_page,
     dismiss_notifications,
+    open_folder,
     settle_for_picture,
     wait_for_nodes,
     wait_until,
@@ -118,7 +119,7 @@ def walk(model: str, numbers: list[int]) -> None:
             if model == "trep":  # the last lesson replayed: the simulation waits, the timeline runs
                 s.start_replay(10.0)
                 wait_until(lambda: s.snapshot().replay is not None, 10.0, "the replay")
-                page.get_by_text("Record and replay", exact=True).click()
+                open_folder(page, "Record and replay")
                 wait_until(lambda: not app.replay.timeline.disabled, 10.0, "the timeline")
                 page.get_by_role("button", name="Back to live").scroll_into_view_if_needed()
                 time.sleep(2.0)

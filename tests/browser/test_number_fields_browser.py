@@ -11,7 +11,7 @@ from playwright.sync_api import Locator, Page
 
 from rns_viz.viz.panels.number_field import shown
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.support.browser import browser_page, dismiss_notifications, wait_until
+from tests.support.browser import browser_page, dismiss_notifications, open_folder, wait_until
 
 FOLDERS = ("Control law and gains", "Model and view", "Record and replay")  # closed at first
 
@@ -49,7 +49,7 @@ def test_typed_gains_are_applied_exactly_or_refused_with_a_message(app: RnsApp) 
     with browser_page(app.server, width=1400, height=900) as page:
         dismiss_notifications(page)
         for folder in FOLDERS:
-            page.get_by_text(folder, exact=True).click()
+            open_folder(page, folder)
         # No slider shows viser's own number box; under each track is a text box showing its value.
         thumbs = page.get_by_role("slider")
         assert thumbs.count() >= 8  # TREP, law (30): kick, path, ū speed, g_b, g_m, drawn ×, replay N s, replay ×

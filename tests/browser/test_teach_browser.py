@@ -33,6 +33,7 @@ from tests.support.browser import (
     dismiss_notifications,
     local_position,
     new_test_page,
+    open_folder,
     screenshot,
     settle_for_picture,
     start_drawing,
@@ -60,7 +61,7 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         settle_for_picture(page, 20)
         assert screenshot(page, "lesson1_start").stat().st_size > 10_000
         # The student ticks the ghost under "Show in the scene", then scrolls back to the lesson.
-        page.get_by_text("Show in the scene", exact=True).click()
+        open_folder(page, "Show in the scene")
         page.get_by_role("checkbox", name="Ghost: the shadow run").click()
         wait_until(lambda: app.view.on("ghost"), 10.0, "the ghost to be ticked")
         page.get_by_text("Lesson 1 of 6", exact=False).scroll_into_view_if_needed()

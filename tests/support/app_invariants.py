@@ -106,12 +106,15 @@ def drawn_violations(app: RnsApp, references: dict[str, set[str]]) -> list[str]:
     drawn_map = ex.scene.gain_map if ex.scene is not None else None
     if drawn_map is not None and (drawn_map.loop.model_name, drawn_map.loop.law) != (st.model, st.law):
         out.append(f"the drawn gain map is {drawn_map.loop.model_name}/{drawn_map.loop.law}'s")
+    ticked = app.view.on("gain_map")  # the map is drawn only while its box in *Show in the scene* is ticked
     if (
         (view.map is None) != (drawn_map is None)
         or ex.scene is None
-        or ex.scene.frame.visible != (view.map is not None)
+        or ex.scene.frame.visible != (view.map is not None and ticked)
     ):
-        out.append("the gain map drawn (or hidden) is not the view's")
+        out.append(f"the gain map drawn (or hidden) is not the view's (its box {'ticked' if ticked else 'unticked'})")
+    elif not ticked and (ex.scene.authority.visible or ex.scene.authority_lines.visible):
+        out.append("the authority overlay is drawn while the gain map's toggle is not ticked")
     on_path = r.model.n - len(r.model.selected) == 1
     texts = {
         "predicted": (ex.predicted.content, predicted_text(view)),

@@ -174,6 +174,12 @@ def dismiss_notifications(page: Page) -> None:
     page.evaluate("() => document.querySelectorAll('.mantine-Notification-closeButton').forEach((b) => b.click())")
 
 
+def open_folder(page: Page, label: str) -> None:
+    """Click the title of the panel folder ``label``, not a text that names it (a lesson or a hint names a
+    folder in *italics*: an ``em`` of the same words)."""
+    page.get_by_text(label, exact=True).and_(page.locator(":not(em, strong, code)")).click()
+
+
 def wait_for_nodes(page: Page, names: set[str], timeout: float = 30.0) -> None:
     """Wait until every name in ``names`` is mounted in the page's scene."""
     missing: set[str] = set(names)

@@ -23,6 +23,7 @@ from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.control_panel import GAIN_SLIDERS, GuiElements
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.model_menu import label_of
+from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.gain_scene import GainScene, Quantity
 from rns_viz.viz.scene.style import SceneStyle
 
@@ -122,9 +123,14 @@ class GainExplorerView:
         self._loci_of: tuple[str, str] | None = None  # (model, law) of the root loci drawn
         self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
 
-    def show(self, on: bool) -> None:
-        """Show or hide the map and the authority overlay in the scene (the *Gain map* toggle)."""
-        if self.scene is not None and self.scene.set_shown(on) and on:
+    def show(self, on: bool, robot_scene: FsmsScene) -> None:
+        """Show or hide the map and the authority overlay in the scene (the *Gain map* toggle). Every camera
+        then frames what is shown: the robot, with the map while it is shown (it stands left of the robot,
+        out of a view framed on the robot alone); *Frame robot* does the same."""
+        if self.scene is None or not self.scene.set_shown(on):
+            return
+        robot_scene.frame_also(self.scene.framed_corners() if on else None)
+        if on:
             self._version, self._drawn, self._next_check = -1, {}, 0.0  # draw the view now
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:

@@ -135,6 +135,7 @@ class FsmsScene:
         )
         self.base_label = self._add_labels()
         self.framed = framed_points(model)  # world points the camera frames
+        self.also_framed: np.ndarray | None = None  # more of them while shown (the gain map's corners)
         self.set_initial_camera()
         self.q = model.q(model.spec.default_configuration)
         self.exaggeration = 1.0
@@ -246,9 +247,17 @@ class FsmsScene:
                 self.frame_client(client)
 
     def camera_pose(self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, width_px: int = 0) -> CameraPose:
-        """Where a camera of this field of view and aspect sees the robot framed (framing.py)."""
+        """Where a camera of this field of view and aspect sees the robot framed (framing.py), with the
+        points of :meth:`frame_also`."""
         direction = np.subtract(self.style.camera_position, self.style.camera_look_at)
-        return frame_points(self.framed, direction, fov, aspect, band=band_for(width_px))
+        points = self.framed if self.also_framed is None else np.vstack([self.framed, self.also_framed])
+        return frame_points(points, direction, fov, aspect, band=band_for(width_px))
+
+    def frame_also(self, points: np.ndarray | None) -> None:
+        """Frame the world ``points`` (N, 3), m, with the robot from now on (None: the robot alone), and
+        frame every connected camera so."""
+        self.also_framed = None if points is None else np.asarray(points, dtype=float).reshape(-1, 3)
+        self.set_initial_camera(clients=True)
 
     def frame_client(self, client: viser.ClientHandle) -> None:
         """Point ``client``'s camera at the robot, framed for its page's size."""

@@ -38,6 +38,7 @@ NOW_COLOUR = (255, 255, 255)
 # the outline shows only as a frame around the map.
 IMAGE_TURN = tuple(vtf.SO3.from_x_radians(math.pi).wxyz)
 PAPER_COLOUR = (20, 20, 20)
+LABEL_ROOM = 0.15  # x the map's side: the title above it, the legend below, the tick labels left of it
 # viridis at 0, 1/4, 1/2, 3/4, 1 (slow decay dark, fast decay yellow)
 _ANCHORS = np.array([[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]], dtype=float)
 
@@ -232,6 +233,12 @@ class GainScene:
             if not on:
                 self.authority.visible = self.authority_lines.visible = False
         return True
+
+    def framed_corners(self) -> np.ndarray:
+        """World corners (4, 3), m, of the map with room for its title, legend and axis ticks around it."""
+        half = 0.5 * self.size + LABEL_ROOM * self.size
+        local = np.array([[x, y, 0.0] for x in (-half, half) for y in (-half, half)])
+        return self.centre + local @ self.rotation.T
 
     def show_now(self, view: GainView) -> None:
         """The white marker at the gains in force (hidden outside the map's range)."""

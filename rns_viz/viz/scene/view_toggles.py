@@ -11,7 +11,10 @@ from dataclasses import dataclass, field
 
 import viser
 
+from rns_viz.defaults import defaults_for
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.teaching.rank_view import RANK_HINT
+from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
@@ -111,6 +114,14 @@ class ViewToggles:
             self.good[name] = name in wanted
             if box.value != self.good[name]:
                 box.value = self.good[name]
+
+
+def first_look(model: FsmsModel) -> frozenset[str]:
+    """What ``model``'s scene shows at first: its parameter file's ``[app.scene] shown``, and the
+    reactionless-reachable set whenever the operator drives a target over it (a selection S that leaves a
+    reaction null space of two or more dimensions): where the target can go is what the operator needs."""
+    shown = defaults_for(model).shown
+    return (shown | {"reach"}) if operator_class(model).shows == "reachable set" else shown
 
 
 def make_view_toggles(gui: viser.GuiApi, connections: Connections, shown: Iterable[str] | None = None) -> ViewToggles:

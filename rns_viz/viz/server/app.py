@@ -21,7 +21,6 @@ from typing import Any
 import numpy as np
 import viser
 
-from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.session import Session
 from rns_viz.live.operator.operator_lock import OperatorLock
 from rns_viz.live.reach.region import arm_reach
@@ -39,7 +38,7 @@ from rns_viz.viz.panels.pictures import Pictures
 from rns_viz.viz.panels.rank_inset import RankInsetPanel
 from rns_viz.viz.panels.replay_panel import ReplayPanel
 from rns_viz.viz.scene.fsms_scene import FsmsScene
-from rns_viz.viz.scene.view_toggles import make_view_toggles
+from rns_viz.viz.scene.view_toggles import first_look, make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
 from rns_viz.viz.server.render import TARGET_HANDLE, Renderer
 
@@ -78,7 +77,7 @@ class RnsApp:
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
         self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
-        self.view = make_view_toggles(server.gui, self.connections, defaults_for(model).shown)
+        self.view = make_view_toggles(server.gui, self.connections, first_look(session.state.model))
         self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
         self.lessons = LessonPanel(
             server, session, self.connections, self.gui.status.order + 0.5, self.view, self.gui.menu.keys.values()

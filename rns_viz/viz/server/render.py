@@ -35,7 +35,7 @@ from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
-from rns_viz.viz.scene.view_toggles import ViewToggles
+from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
 from rns_viz.viz.server.drawn_factor import DrawnFactor
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
@@ -152,7 +152,7 @@ class Renderer:
         controls.show(g.exaggeration, defaults.exaggeration)
         controls.show(g.auto_exaggeration, defaults.auto_exaggeration)
         kept = {name for name in KEPT_ACROSS_MODELS if self.view.on(name)}  # the viewer's choice, not the model's
-        self.view.show_only(defaults.shown | kept)  # the new model's first look
+        self.view.show_only(first_look(self.model) | kept)  # the new model's first look
         self._seen = _Seen()
         self.sync_settings(snap)
         self.model_name = snap.settings.model
@@ -224,7 +224,7 @@ class Renderer:
         if paths != seen.paths:
             seen.paths = paths
             seen.overlay_version = -1  # redrawn with or without the family
-        self.explorer.show(view.on("gain_map"))
+        self.explorer.show(view.on("gain_map"), self.scene)
 
     def _draw_state(self, snap: Snapshot, exaggeration: float) -> None:
         """The arm, the base and the reaction arrow (and the base label's factor), when what a viewer sees changed."""
