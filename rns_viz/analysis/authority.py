@@ -116,7 +116,7 @@ class KickMeasure:
 def measure_kick(t: np.ndarray, y: np.ndarray, kick_end: float, quiet: float | None = None) -> KickMeasure:
     """Peak, time to 10 % and decay of a deflection y(t) logged from a kick's start; ``kick_end`` in s.
 
-    The time to 10 % counts once |y| has stayed under 10 % of its peak for ``quiet`` s at the end of the
+    The time to 10 % counts once ``|y|`` has stayed under 10 % of its peak for ``quiet`` s at the end of the
     log (default: as long as it took to get there, at least a second): a swing may still come back."""
     t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
     a = np.abs(y)

@@ -56,13 +56,13 @@ PAPER_GAINS: dict[tuple[str, LawKind], tuple[PaperGains, ...]] = {
 CSV_COLUMNS: dict[str, str] = {
     "g_b": "1/s",
     "g_m": "1/s",
-    "base_decay_rate": "1/s",  # sigma_b, the slowest decay of the modes the base shows (negative: grows)
-    "arm_decay_rate": "1/s",  # sigma_a, the slowest of the other modes (nan if none)
-    "base_damping_ratio": "1",
+    "base_decay_rate": "1/s",  # sigma_b = ln 10 / base_time_to_10pct (growing loop: its fastest growth, negative)
+    "arm_decay_rate": "1/s",  # sigma_a, the slowest decay of the modes under 5 % of the kick's peak (nan if none)
+    "base_damping_ratio": "1",  # of the pole that carries the deflection as it passes 10 % (1 if real)
     "stable": "1 = stable",  # every mode decays
-    "base_time_to_10pct": "s",  # ln 10 / sigma_b (inf if it does not decay)
-    "arm_time_to_10pct": "s",
-    "base_frequency": "rad/s",  # |Im lambda| of the slowest base pole
+    "base_time_to_10pct": "s",  # after the kick's end until |x_b| stays under 10 % of its peak (inf if it grows)
+    "arm_time_to_10pct": "s",  # ln 10 / sigma_a
+    "base_frequency": "rad/s",  # |Im lambda| of that pole
     "predictable": "1 = predictable",  # the kick's response stays in the linear range (else the map hatches it)
     "swing": "rad",  # the joints' largest swing outside the RNS while absorbing the kick
     "reason": "code",  # why not predictable: 0 it is, 1 swing too large, 2 a joint limit, 3 decays within the kick
