@@ -188,7 +188,13 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     client = next(iter(app.server.get_clients().values()))
     cam = client.camera
     wait_until(lambda: cam.update_timestamp > 0 and cam.image_width > 0, 10.0, "the page's camera")
-    half_view = math.tan(0.5 * cam.fov) * min(cam.image_width / cam.image_height, 1.0)  # per unit of distance
+    # the scene's own canvas as laid out now, between the docked panels (the camera's size may predate them)
+    width, height = page.evaluate(
+        "() => { const c = [...document.querySelectorAll('canvas')].sort((a, b) =>"
+        " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
+        " return [c.clientWidth, c.clientHeight]; }"
+    )
+    half_view = math.tan(0.5 * cam.fov) * min(width / height, 1.0)  # per unit of distance
     cam.position = scene.centre + 0.5 * scene.size / (FACING_FILL * half_view) * scene.rotation[:, 2]
     cam.look_at = scene.centre
     wait_for_frames(page, 10)
