@@ -11,6 +11,7 @@ tests/support/browser.py). The fixtures of one level live in its folder's confte
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -35,6 +36,13 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         if level == "browser":
             for mark in _browser_marks():
                 item.add_marker(mark)
+
+
+def pytest_sessionfinish() -> None:
+    """Close the test process's shared Chromium, if a browser test started one (tests/support/browser.py)."""
+    browser = sys.modules.get("tests.support.browser")
+    if browser is not None:
+        browser.CHROMIUMS.close()
 
 
 def _browser_marks() -> list[pytest.MarkDecorator]:
