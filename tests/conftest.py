@@ -5,8 +5,8 @@ for a parametrised name; boom-panda skips without its extra, and ``panda_not_ins
 Folders are levels: ``unit`` (pure functions and physics: the developer's loop, ``python -m pytest
 tests/unit``), ``session`` (a headless Session), ``app`` (a viser server, protocol clients), ``browser``
 (Chromium). Each test gets its folder's marker, so ``-m unit`` works from anywhere; a browser test also
-gets the browser's skip-or-fail rule and the "live" xdist group (one wall-clock test at a time,
-tests/support/browser.py). The fixtures of one level live in its folder's conftest.py.
+gets the browser's skip-or-fail rule (tests/support/browser.py). The fixtures of one level live in its
+folder's conftest.py.
 """
 
 from __future__ import annotations
@@ -46,8 +46,8 @@ def pytest_sessionfinish() -> None:
 
 
 def _browser_marks() -> list[pytest.MarkDecorator]:
-    """The browser marker, its skip-or-fail rule and the "live" group (imported only when browser tests
-    are collected: Playwright and the app are not needed below that level)."""
+    """The browser marker and its skip-or-fail rule (imported only when browser tests are collected:
+    Playwright and the app are not needed below that level)."""
     from tests.support.browser import browser_marks
 
     return browser_marks
