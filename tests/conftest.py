@@ -11,6 +11,7 @@ folder's conftest.py.
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable, Iterator
 from dataclasses import replace
@@ -24,6 +25,18 @@ from rns_viz.params import missing_extra
 
 LEVELS = ("unit", "session", "app", "browser")
 TESTS = Path(__file__).resolve().parent
+
+
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int | None:
+    """``-n auto`` (pyproject's addopts): a worker per core, and one more when the run goes beyond tests/unit.
+    The session, app and browser tests spend much of their time waiting (for simulated time in real time, a
+    page, a helper process); the extra worker computes meanwhile. PYTEST_XDIST_AUTO_NUM_WORKERS still rules."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None  # xdist's own hook reads it
+    cores = len(os.sched_getaffinity(0))
+    unit = TESTS / "unit"
+    paths = [Path(str(arg).split("::")[0]).resolve() for arg in config.args] or [TESTS]
+    return cores if all(path.is_relative_to(unit) for path in paths) else cores + 1
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the groups and -m selects by marker
