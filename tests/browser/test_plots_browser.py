@@ -53,15 +53,21 @@ def y_ticks(page: Page, handle: Any) -> dict[str, Any] | None:
     return page.evaluate(Y_TICKS_JS, handle._impl.uuid)
 
 
-def assert_readable_ticks(page: Page, handle: Any, what: str) -> None:
-    """The chart's y tick labels are all different and none has five digits (e.g. "100,000")."""
-    wait_until(lambda: any((y_ticks(page, handle) or {}).get("ticks", [])), 10.0, f"the y ticks of {what}")
-    axis = y_ticks(page, handle)
-    assert axis is not None, what
-    labels = [t for t in axis["ticks"] if t]
-    assert len(labels) >= 2 and len(set(labels)) == len(labels), (what, axis)
+def readable(axis: dict[str, Any] | None) -> bool:
+    """The y tick labels are at least two, all different, and none has five digits (e.g. "100,000")."""
+    labels = [t for t in (axis or {}).get("ticks", []) if t]
     digits = [len(re.sub(r"\D", "", t.split(".")[0])) for t in labels]
-    assert max(digits) <= 4, (what, axis)
+    return len(labels) >= 2 and len(set(labels)) == len(labels) and max(digits) <= 4
+
+
+def assert_readable_ticks(page: Page, handle: Any, what: str) -> None:
+    """The chart's y axis, once drawn for its new data, reads (:func:`readable`). The page draws new data and
+    its axis in its own time, so a read may still see the axis of the data before (a flat run's lone "0"): the
+    test waits up to 10 s for a readable axis, and an axis that stays unreadable fails with what it shows."""
+    try:
+        wait_until(lambda: readable(y_ticks(page, handle)), 10.0, f"readable y ticks of {what}")
+    except AssertionError:
+        raise AssertionError((what, y_ticks(page, handle))) from None
 
 
 @pytest.fixture
