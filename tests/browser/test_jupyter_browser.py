@@ -23,9 +23,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from playwright.sync_api import sync_playwright
 
-from tests.support.browser import CHROMIUM, chromium_flags, new_test_page, wait_until
+from tests.support.browser import url_page, wait_until
 from tests.support.repo import REPO
 
 pytest.importorskip("jupyter_server_proxy", reason="needs the extra: pip install 'rns-viz[jupyter]'")
@@ -107,25 +106,20 @@ def _answers(url: str) -> bool:
 
 def test_the_app_runs_through_jupyter_server_proxy_and_a_kick_moves_its_plot(jupyter: tuple[str, str]) -> None:
     base, token = jupyter
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(), headless=True)
-        try:
-            page = new_test_page(browser, 1280, 800)
-            page.goto(f"{base}/rns-viz/?token={token}", timeout=START_S * 1000)
-            assert "/rns-viz/" in page.url  # served under the proxy's prefix
-            kick = page.get_by_role("button", name="Kick the base")
-            kick.wait_for(timeout=START_S * 1000)  # the panel came over the websocket, through the proxy
-            wait_until(lambda: len(page.evaluate(CHART_PEAKS_JS)) >= 2, 30.0, "the live plots")
-            time.sleep(1.0)
-            before = page.evaluate(CHART_PEAKS_JS)
-            at_rest = [uuid for uuid, peak in before.items() if peak < 1e-6]
-            assert at_rest, before  # TREP at rest: its live signals (base deflection, ...) are zero
-            kick.click()  # the input goes back through the proxy to the app
+    # the shared Chromium of this test process (a second Playwright driver would clash with its loop)
+    with url_page(f"{base}/rns-viz/?token={token}", timeout=START_S) as page:
+        assert "/rns-viz/" in page.url  # served under the proxy's prefix
+        kick = page.get_by_role("button", name="Kick the base")
+        kick.wait_for(timeout=START_S * 1000)  # the panel came over the websocket, through the proxy
+        wait_until(lambda: len(page.evaluate(CHART_PEAKS_JS)) >= 2, 30.0, "the live plots")
+        time.sleep(1.0)
+        before = page.evaluate(CHART_PEAKS_JS)
+        at_rest = [uuid for uuid, peak in before.items() if peak < 1e-6]
+        assert at_rest, before  # TREP at rest: its live signals (base deflection, ...) are zero
+        kick.click()  # the input goes back through the proxy to the app
 
-            def moved() -> bool:
-                after = page.evaluate(CHART_PEAKS_JS)
-                return any(after.get(uuid, 0.0) > 1e-3 for uuid in at_rest)
+        def moved() -> bool:
+            after = page.evaluate(CHART_PEAKS_JS)
+            return any(after.get(uuid, 0.0) > 1e-3 for uuid in at_rest)
 
-            wait_until(moved, 30.0, "a plot at rest to show the kick")
-        finally:
-            browser.close()
+        wait_until(moved, 30.0, "a plot at rest to show the kick")
