@@ -229,7 +229,10 @@ def test_map_image_marks_unstable_cells_and_clicks_map_to_cells(app: RnsApp) -> 
 
 
 def test_panel_states_the_views_and_the_loci_split_base_and_arm(app: RnsApp) -> None:
-    ex, view = explorer(app), app.session.gain_view()
+    s = app.session
+    s.advance(0.01)  # an earlier test may have clicked a cell: the loci of its gains come from the helper
+    assert s.wait_background()
+    ex, view = explorer(app), s.gain_view()
     assert view.g_m_meaning in app.gui.gains["g_m"].hint
     assert "predicted" in ex.predicted.content and "1/s" in ex.predicted.content
     assert "1/s" in ex.authority.content
