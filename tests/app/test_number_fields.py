@@ -5,6 +5,7 @@ turned ``1e9`` into 19). Text is sent as a browser sends it, by a protocol-level
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterator
 from dataclasses import fields
 
@@ -12,7 +13,7 @@ import pytest
 
 from rns_viz.live.loop.commands import Scrub
 from rns_viz.viz.panels import number_field
-from rns_viz.viz.panels.input_check import parse_number
+from rns_viz.viz.panels.input_check import is_unfinished_number, parse_number
 from rns_viz.viz.panels.number_field import NumberField, shown
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import wait_for_clients, wait_until
@@ -199,3 +200,37 @@ def test_parse_number_reads_numbers_only() -> None:
     for text in ("abc", "1,5", "", "1e", "-", "0x10"):
         with pytest.raises(ValueError, match="is not a number"):
             parse_number("g_b (1/s)", text)
+
+
+def test_a_half_typed_number_is_not_refused_after_a_short_pause(
+    typing_app: tuple[RnsApp, ProtocolClient, Told], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """'2e-' (an exponent on its way) waits for the longer pause: no 'not a number' after the short one,
+    and '2e-3' typed next is applied as 0.002 without a word."""
+    app, client, told = typing_app
+    monkeypatch.setattr(number_field, "TYPING_PAUSE_S", 0.3)
+    monkeypatch.setattr(number_field, "UNFINISHED_PAUSE_S", 60.0)  # longer than this test: never reached
+    g_b = app.gui.gains["g_b"]
+    applied: list[float] = []
+    original = app.session.set_gains
+
+    def spy(client_id, **changes):  # type: ignore[no-untyped-def]
+        applied.append(changes.get("g_b", math.nan))
+        original(client_id, **changes)
+
+    app.session.set_gains = spy  # type: ignore[method-assign]
+    before = len(told)
+    client.set_value(gui_uuid(g_b.box), "2e-")
+    wait_until(lambda: g_b.typing(), 10.0, "the keystroke to arrive")
+    time.sleep(1.0)  # well past the short pause
+    assert applied == [] and told[before:] == [] and g_b.typing()
+    client.set_value(gui_uuid(g_b.box), "2e-3")
+    wait_until(lambda: applied == [0.002] and not g_b.typing(), 10.0, "2e-3 to be read")
+    assert told[before:] == []
+
+
+def test_a_numbers_beginning_is_told_from_text_that_is_no_number() -> None:
+    for text in ("", "-", "+", ".", "1e", "1e-", "2.5E+", " 3e "):
+        assert is_unfinished_number(text), text
+    for text in ("1", "1.", "-0", "1e-3", "abc", "NaN", "e", "--", "1e-3x", "0x"):
+        assert not is_unfinished_number(text), text

@@ -30,14 +30,16 @@ from tests.support.repo import REPO
 pytest.importorskip("jupyter_server_proxy", reason="needs the extra: pip install 'rns-viz[jupyter]'")
 
 START_S = 120.0  # s: Jupyter up, then the app started by the proxy on the first visit (a loaded machine)
-# The largest finite value of every chart on the page (viser's uPlot test points), by chart.
+# The largest finite value of every chart on the page (viser's uPlot test points), by the chart's series
+# labels: the app may rebuild its plots (new uuids) while the page loads, a chart's labels stay.
 CHART_PEAKS_JS = """() => {
   const out = {};
-  for (const [uuid, tp] of Object.entries(window.__viserTestpoints?.uplots ?? {})) {
+  for (const tp of Object.values(window.__viserTestpoints?.uplots ?? {})) {
     const d = tp.chart.data; let peak = 0;
     for (let s = 1; s < d.length; s++)
       for (const v of d[s] ?? []) if (Number.isFinite(v)) peak = Math.max(peak, Math.abs(v));
-    out[uuid] = peak;
+    const key = (tp.chart.series ?? []).slice(1).map((s) => String(s.label ?? "")).join("|");
+    out[key] = Math.max(out[key] ?? 0, peak);
   }
   return out;
 }"""
@@ -114,12 +116,17 @@ def test_the_app_runs_through_jupyter_server_proxy_and_a_kick_moves_its_plot(jup
         wait_until(lambda: len(page.evaluate(CHART_PEAKS_JS)) >= 2, 30.0, "the live plots")
         time.sleep(1.0)
         before = page.evaluate(CHART_PEAKS_JS)
-        at_rest = [uuid for uuid, peak in before.items() if peak < 1e-6]
+        at_rest = [key for key, peak in before.items() if peak < 1e-6]
         assert at_rest, before  # TREP at rest: its live signals (base deflection, ...) are zero
         kick.click()  # the input goes back through the proxy to the app
 
-        def moved() -> bool:
-            after = page.evaluate(CHART_PEAKS_JS)
-            return any(after.get(uuid, 0.0) > 1e-3 for uuid in at_rest)
+        seen: dict[str, float] = {}
 
-        wait_until(moved, 30.0, "a plot at rest to show the kick")
+        def moved() -> bool:
+            seen.update(page.evaluate(CHART_PEAKS_JS))
+            return any(seen.get(key, 0.0) > 1e-3 for key in at_rest)
+
+        try:
+            wait_until(moved, 30.0, "a plot at rest to show the kick")
+        except AssertionError as e:
+            raise AssertionError(f"{e}: at rest {at_rest}, now {seen}") from e

@@ -10,6 +10,7 @@ Typed numbers arrive as text: :func:`parse_number` reads them (and only reads th
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import viser
@@ -51,3 +52,18 @@ def parse_number(label: str, text: str) -> float:
         shown = text if len(str(text)) <= 40 else f"{str(text)[:40]}…"
         raise ValueError(f"{label}: {shown!r} is not a number (numbers look like 2.5, -0.3 or 1e-3)") from None
     return value + 0.0  # -0.0 becomes 0.0
+
+
+# A number's beginning that is not yet a number: "", "-", ".", "1e", "2.5e-" (the reading waits longer).
+_NUMBER_START = re.compile(r"\s*[+-]?((\d+\.?\d*|\.\d*)([eE][+-]?)?)?\s*")
+
+
+def is_unfinished_number(text: str) -> bool:
+    """``text`` is how a number begins but is not one yet (``1e-`` on the way to ``1e-3``)."""
+    if _NUMBER_START.fullmatch(text) is None:
+        return False
+    try:
+        float(text)
+    except ValueError:
+        return True
+    return False

@@ -7,7 +7,8 @@ is typed into a text box under the track, read on the server (:func:`rns_viz.viz
 text that is not a number is refused with a message, never turned into another number.
 
 A text box sends every keystroke, so the text is read once the typing pauses (:data:`TYPING_PAUSE_S`),
-not at ``1`` on the way to ``1e9``. (Enter cannot be used: viser sends a form's submit through the same
+not at ``1`` on the way to ``1e9``; a number's beginning such as ``1e-`` waits longer
+(:data:`UNFINISHED_PAUSE_S`). (Enter cannot be used: viser sends a form's submit through the same
 throttled channel as the text, and a submit within 50 ms of the last keystroke replaces the keystroke.)
 """
 
@@ -18,7 +19,12 @@ from collections.abc import Callable
 
 import viser
 
+from rns_viz.viz.panels.input_check import is_unfinished_number
+
 TYPING_PAUSE_S = 0.8  # s: typed text is read this long after its last keystroke
+# s: ... or this long if it is a number's beginning ("1e-"): someone is typing an exponent, or a busy
+# machine delivered the keys late; a half-typed number is not refused as "not a number" after a short pause
+UNFINISHED_PAUSE_S = 3.0
 # Hides the number box viser puts beside every slider (it mangles typed numbers); each slider of the
 # app is a NumberField, whose text box shows and takes the value instead.
 SLIDER_BOX_CSS = "<style>.mantine-Slider-root + .mantine-NumberInput-root { display: none; }</style>"
@@ -163,7 +169,8 @@ class NumberField:
                 waiting = self._timers.pop(client.client_id, None)
                 if waiting is not None:
                     waiting.cancel()
-                timer = threading.Timer(TYPING_PAUSE_S, self._paused, (client, typed))
+                pause = UNFINISHED_PAUSE_S if is_unfinished_number(str(event.target.value)) else TYPING_PAUSE_S
+                timer = threading.Timer(pause, self._paused, (client, typed))
                 timer.daemon = True
                 self._timers[client.client_id] = timer
                 timer.start()
