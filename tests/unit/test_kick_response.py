@@ -104,7 +104,7 @@ def test_the_maps_numbers_are_the_linear_step_maps(
             abs(m.swing[i, j] / swing - 1),
         )
         worst = np.maximum(worst, errors)
-    assert np.all(worst < (0.05, 0.05, 0.05, 0.1)), worst
+    assert np.all(worst < (0.01, 0.01, 0.01, 0.1)), worst
 
 
 def test_measure_kick_reads_closed_forms() -> None:
