@@ -84,7 +84,7 @@ def serve(model: str, teach: str | None = None) -> None:
         "port": app.port,
         "plot": g.plot_xb._impl.uuid,
         "kick": g.kick._impl.uuid,
-        "g_b": g.gains["g_b"]._impl.uuid,
+        "g_b": g.gains["g_b"].slider._impl.uuid,  # a NumberField: its slider carries the uuid
         "cyclic": g.cyclic._impl.uuid,
         "handle": TARGET_HANDLE,
     }

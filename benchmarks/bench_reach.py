@@ -22,9 +22,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from rns_viz.integrability import bracket_rank
 from rns_viz.live.reach.region import VOXELS_PER_REACH, arm_reach, build_reach_region
-from rns_viz.live.reach.spatial import bracket_rank, explore_rns
 from rns_viz.model import FsmsModel
+from rns_viz.paths import explore_rns
 
 SELECTIONS = {
     "forces (x y z)": [1, 1, 1, 0, 0, 0],

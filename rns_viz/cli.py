@@ -6,7 +6,6 @@ Bad arguments give one clear line on stderr and exit status 2, never a traceback
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import os
@@ -17,14 +16,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rns_viz.params import MODEL_NAMES, ModelFileError, model_key
+from rns_viz.params import MODEL_NAMES, ModelFileError, model_key, param_file_for
 
 if TYPE_CHECKING:
     from rns_viz.model import FsmsModel
 
-MODEL_HELP = (
-    "trep, trep2, planar3r, boom7 (bundled), boom-panda (with rns-viz[panda]), or a model's parameter file (.toml)"
-)
+MODEL_HELP = f"{', '.join(MODEL_NAMES)} (bundled; a packaged arm needs its extra), or a model's parameter file (.toml)"
 
 
 class CliError(Exception):
@@ -84,6 +81,24 @@ def _load_model(name: str) -> FsmsModel:
     return FsmsModel.from_file(name) if name.endswith(".toml") else FsmsModel.from_name(name)
 
 
+def _models_in(folder: Path) -> list[str]:
+    """The model keys of the parameter files (``*.toml``) in ``folder`` that read as models; each one that
+    does not is named on stderr and left out (a folder of a student's files must not stop the app)."""
+    if not folder.is_dir():
+        if folder.exists():
+            raise CliError(f"--model-dir {folder}: not a folder")
+        return []
+    keys = []
+    for path in sorted(folder.glob("*.toml")):
+        try:
+            _load_model(str(path))
+        except (ModelFileError, OSError) as exc:
+            print(f"rns-viz: skipping {path}: {exc}", file=sys.stderr)
+            continue
+        keys.append(model_key(str(path)))
+    return keys
+
+
 def _open_for_writing(path: Path):
     try:
         return path.open("w", newline="")
@@ -125,7 +140,9 @@ def cmd_info(args: argparse.Namespace) -> None:
 
 
 def cmd_paths(args: argparse.Namespace) -> None:
+    from rns_viz.csvio import write_csv
     from rns_viz.paths import path_family
+    from rns_viz.sim.log import arm_units
 
     model = _load_model(args.model)
     out = Path(args.csv)
@@ -135,14 +152,11 @@ def cmd_paths(args: argparse.Namespace) -> None:
     except ValueError as exc:
         handle.close()
         raise CliError(str(exc)) from None
+    units = ["index", "rad", *[u.position for u in arm_units(model)], "m", "m", "m"]
+    columns = ["path", "s", *[f"theta_{i + 1}" for i in range(model.n)], "ee_x", "ee_y", "ee_z"]
+    rows = [np.column_stack((np.full(len(p.s), i), p.s, p.theta, p.ee)) for i, p in enumerate(paths)]
     with handle:
-        writer = csv.writer(handle)
-        writer.writerow(["path", "s", *[f"theta_{i + 1}" for i in range(model.n)], "ee_x", "ee_y", "ee_z"])
-        for index, path in enumerate(paths):
-            for s, theta, ee in zip(path.s, path.theta, path.ee, strict=True):
-                writer.writerow(
-                    [index, repr(float(s)), *(repr(float(t)) for t in theta), *(repr(float(e)) for e in ee)]
-                )
+        write_csv(handle, columns, units, np.concatenate(rows))
     ends = sorted({p.end for p in paths})
     print(f"wrote {len(paths)} paths ({sum(len(p.s) for p in paths)} points; ends: {', '.join(ends)}) to {out}")
 
@@ -229,17 +243,40 @@ def cmd_serve(args: argparse.Namespace) -> None:
     models = [model_key(name) for name in args.model or ["trep"]]  # files by absolute path: one key each
     for name in models:  # every file is read and checked now: a bad one is refused before serving
         _load_model(name)
+    if args.model_dir is not None:
+        models += [name for name in _models_in(Path(args.model_dir)) if name not in models]
     model = models[0]
     if args.lesson is not None:
-        from rns_viz.live.teaching.lessons import LESSONS
+        from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
 
-        if model not in LESSONS:
-            raise CliError(f"{model} has no lessons; there are some for {', '.join(LESSONS)}")
-        count = len(LESSONS[model])
+        count = len(lessons_for(model))
+        if count == 0:
+            raise CliError(f"{model} has no lessons; there are some for {', '.join(models_with_lessons())}")
         if args.lesson > count:
             raise CliError(f"{model} has lessons 1 to {count}, not {args.lesson}")
     extra = [name for name in models if name.endswith(".toml")]
-    serve(model=model, host=args.host, port=args.port, password=password, lesson=args.lesson, models=extra)
+    if args.each_visitor:
+        from rns_viz.viz.server.classroom import serve_classroom
+
+        if args.lesson is not None:
+            raise CliError("--lesson and --each-visitor do not go together: each visitor starts their own lessons")
+        if password is not None:
+            raise CliError(
+                "--password has no use with --each-visitor: every visitor operates their own simulation, and the "
+                "presenter is the page opened on this machine"
+            )
+        serve_classroom(model, args.host, args.port, extra, args.max_visitors, args.idle_minutes)
+        return
+    serve(
+        model=model,
+        host=args.host,
+        port=args.port,
+        password=password,
+        lesson=args.lesson,
+        models=extra,
+        present=args.present,
+        pause_unwatched=args.pause_unwatched,
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -248,7 +285,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Reaction null-space control of a flexible-structure-mounted manipulator "
         "(Nenchev et al. 1999). Without a command, starts the browser app.",
     )
-    lesson_help = "start the app at lesson N of the model (TREP: 1-6, planar3r: 1-3, boom7: 1-3)"
+    offered = ((name, len(param_file_for(name).app.lessons)) for name in MODEL_NAMES)
+    counts = ", ".join(f"{name}: 1-{count}" for name, count in offered if count)
+    lesson_help = f"start the app at lesson N of the model ({counts})"
     parser.add_argument("--lesson", dest="top_lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
     sub = parser.add_subparsers(dest="command")
     info = sub.add_parser("info", help="print a model's dimensions and base parameters as JSON")
@@ -272,7 +311,7 @@ def build_parser() -> argparse.ArgumentParser:
     gains = sub.add_parser("gains", help="map the closed loop's base and arm decay rates over g_b x g_m as CSV")
     gains.add_argument("--model", type=_model_arg, default="trep", help=MODEL_HELP)
     gains.add_argument("--law", type=_law_arg, default="velocity", help="15, 16, 30 or acceleration, torque, velocity")
-    gains.add_argument("--csv", required=True, help="output file (gains and rates in 1/s, see README)")
+    gains.add_argument("--csv", required=True, help="output file (gains and rates in 1/s; see the CSV formats docs)")
     gains.add_argument("--size", type=_positive_int, default=60, help="grid points per axis (default 60)")
     gains.add_argument(
         "--theta-deg", type=float, nargs="+", default=None, help="the rest configuration, deg (default: the model's)"
@@ -292,10 +331,45 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         help=MODEL_HELP + "; the first is served, every file joins the model dropdown (repeat to add more)",
     )
+    serve.add_argument(
+        "--model-dir",
+        metavar="DIR",
+        default=None,
+        help="every model parameter file (*.toml) in DIR joins the model dropdown (files that do not read are skipped)",
+    )
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     serve.add_argument("--port", type=_port, default=8080)
     serve.add_argument("--password", default=None, help="operator password (or RNS_VIZ_PASSWORD)")
     serve.add_argument("--lesson", metavar="N", type=_positive_int, default=None, help=lesson_help)
+    serve.add_argument(
+        "--pause-unwatched",
+        action="store_true",
+        help="pause the simulation while no page is open (one student's app on JupyterHub: little CPU when idle)",
+    )
+    serve.add_argument(
+        "--each-visitor",
+        action="store_true",
+        help="give every browser page its own simulation (a lab room on one machine; see docs/deploy/classroom.md)",
+    )
+    serve.add_argument(
+        "--max-visitors",
+        metavar="N",
+        type=_positive_int,
+        default=None,
+        help="with --each-visitor: simulations at once (default 3 per CPU core); later pages wait for a place",
+    )
+    serve.add_argument(
+        "--idle-minutes",
+        metavar="M",
+        type=_positive_float,
+        default=20.0,
+        help="with --each-visitor: close a simulation after M minutes without input (paused after M/4, at most 5)",
+    )
+    serve.add_argument(
+        "--present",
+        action="store_true",
+        help="for a projector: larger text, wider plots, fewer folders (no gain explorer, replay, gains, log)",
+    )
     serve.set_defaults(func=cmd_serve)
     return parser
 

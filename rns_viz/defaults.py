@@ -1,113 +1,83 @@
-"""Per-model defaults in one table: the law and gains the app starts with, kick sizes, drawing scale.
+"""Per-model defaults of the live app: the law and gains it starts with, kick sizes, drawing scale, target speed.
 
-The paper's experiments (rns_viz.scenarios) use the paper's gains; these are what the live app offers
-first. Units: gains as in :class:`~rns_viz.control.Gains`, forces N, durations s.
+The numbers are in each model's parameter file, table ``[app]`` (rns_viz.param_file.AppTable: units in
+the keys); a file without one gets AppTable's defaults and FALLBACK_GAINS. The paper's experiments
+(rns_viz.scenarios) use the paper's gains; these are what the live app offers first. Units: gains as
+in :class:`~rns_viz.control.Gains`, forces N, durations s.
 
-Why these gains. Law (30), TREP: g_b = 24, g_m = 20 as in Fig. 10. Laws (15)/(16): with the joints'
-motion outside the RNS damped by G_m and the base by g_b, the base closed loop (1-DOF base, stiffness
-k, no structural damping) has the characteristic polynomial
-    H_b s^3 + H_b (G_m + g_b) s^2 + k s + k G_m,
-whose slowest root decays fastest near g_b = 10, G_m = 2 for TREP (about 4 /s). The 3R would decay
-fastest near g_b = 2.5, G_m = 0.4 (0.92 /s), but absorbing a 5 N kick then shifts the arm's
-centre of mass so far (by about H_b g_b x_b / G_m) that the arm, holding its end effector, runs into a
-singularity of J-bar = J P_RNS; G_m = 1 (Fig. 3's value) decays at 0.37 /s and keeps the end effector
-on target.
-
-Kicks. "An arbitrary external force" (Sec. VII-D): a half-sine push on the base along x. TREP:
-0.8 N for 0.1 s, an impulse of 0.051 N s, about 5 mm of deflection. The 3R: 5 N for 0.2 s on its
-31 kg base (0.64 N s, about 1.1 cm); law (15) absorbs a deflection by moving the arm's centre of
-mass, so a much larger kick needs more than the arm's reach and drives it into H_bm = 0.
-
-trep2 (TREP with a compensating second arm, Sec. III-B): only the compensating law, resolved
-acceleration like (15), with TREP's (15) gains g_b = 10 (now through the compensator alone) and
-G_m = 2 on the coupling momentum; TREP's kick (the beam and tip are TREP's). The task target moves
-at 0.1 m/s (half the task arm's reach per second): the compensator, about 1.1 times as fast as the
-task arm to cancel it, then turns at 1-2 rad/s, far below its joints' URDF velocity limits
-(20 rad/s), above which the app says the compensator is asked too much.
-
-boom7 (the spatial model): law (15) with g_b = 10, G_m = 2 on all six
-tip modes (the kick preset's, rns_viz.scenarios); kicks of 5 N, 0.1 s (the preset's lateral size:
-about 1.5 mm of a 4 m boom with the arm held, drawn 50x). Its kick needs a direction: along the first
-base coordinate alone it would push the stiff axial mode (157 Hz, 1e-7 m).
+Why the bundled models' numbers: in the comments of their ``[app]`` tables (``rns_viz/assets/*.toml``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from rns_viz.control import Gains, LawKind
-from rns_viz.params import model_source
+from rns_viz.control import Gains, InvalidGain, LawKind
+from rns_viz.model import FsmsModel
+from rns_viz.param_file import LAW_NAMES, AppTable, LawGains, ModelFileError
+from rns_viz.params import param_file_for
 
 
 @dataclass(frozen=True)
 class ModelDefaults:
     law: LawKind  # the law the app starts with
-    gains: dict[LawKind, Gains] = field(default_factory=dict)  # per law; others get FALLBACK_GAINS
-    kick_peak_N: float = 1.0  # the kick button's default peak force
-    kick_duration_s: float = 0.1  # half-sine duration of a kick
-    kick_range_N: float = 5.0  # the kick slider's half range
-    kick_axis: int = 0  # the base coordinate a kick pushes along first (the panel's choice, the gain map's kick)
-    exaggeration: float = 10.0  # drawn deflection factor
-    target_speed_m_s: float = 0.5  # speed limit of the smoothed end-effector target
+    gains: dict[LawKind, Gains]  # per law; others get FALLBACK_GAINS
+    kick_peak_N: float  # the kick button's default peak force
+    kick_duration_s: float  # half-sine duration of a kick
+    kick_range_N: float  # the kick slider's half range
+    kick_axis: int  # the base coordinate a kick pushes along first (the panel's choice)
+    exaggeration: float  # drawn deflection factor (fixed; with auto on: the first one drawn)
+    auto_exaggeration: bool  # the factor follows the motion (rns_viz.viz.scene.auto_scale)
+    target_speed_m_s: float  # speed limit of the smoothed end-effector target
+    # what the scene shows at first (rns_viz.param_file.Overlay): only what a first look needs; the rest is a
+    # tick away in *Show in the scene*, and lessons choose their own
+    shown: frozenset[str]
 
     def gains_for(self, law: LawKind) -> Gains:
         return self.gains.get(law, FALLBACK_GAINS)
 
 
 FALLBACK_GAINS = Gains(g_b=10.0, g_m=1.0)
+MANUAL_EXAGGERATION = 10.0  # the fixed factor a file with exaggeration = "auto" starts the box with
 # m: a kick about a rotational base coordinate is the moment of the kick's force at this lever arm
 # (boom7: the slider's 20 N give 2 N m). A moment equal to the force in N would be a lever of 1 m, and
 # 5 N m about the boom's z axis asks the suppressing arm to spin at over 100 rad/s (the run stops).
 KICK_LEVER_M = 0.1
 
-MODEL_DEFAULTS: dict[str, ModelDefaults] = {
-    "trep": ModelDefaults(
-        law="velocity",
-        gains={
-            "velocity": Gains(g_b=24.0, g_m=20.0),
-            "acceleration": Gains(g_b=10.0, g_m=2.0),
-            "torque": Gains(g_b=10.0, g_m=2.0),
-        },
-        kick_peak_N=0.8,
-        kick_duration_s=0.1,
-        kick_range_N=5.0,
-        exaggeration=10.0,
-    ),
-    "planar3r": ModelDefaults(
-        law="acceleration",
-        gains={
-            "acceleration": Gains(g_b=2.5, g_m=1.0),
-            "torque": Gains(g_b=2.5, g_m=1.0),
-            "velocity": Gains(g_b=2.5, g_m=1.0),
-        },
-        kick_peak_N=5.0,
-        kick_duration_s=0.2,
-        kick_range_N=50.0,
-        exaggeration=20.0,
-    ),
-    "boom7": ModelDefaults(
-        law="acceleration",
-        gains={"acceleration": Gains(g_b=10.0, g_m=2.0), "torque": Gains(g_b=10.0, g_m=2.0)},
-        kick_peak_N=5.0,
-        kick_duration_s=0.1,
-        kick_range_N=20.0,
-        kick_axis=1,  # y: sideways, where the boom is soft (along x it is stiff)
-        exaggeration=50.0,
-    ),
-    "trep2": ModelDefaults(
-        law="acceleration",
-        gains={"acceleration": Gains(g_b=10.0, g_m=2.0)},
-        kick_peak_N=0.8,
-        kick_duration_s=0.1,
-        kick_range_N=5.0,
-        exaggeration=10.0,
-        target_speed_m_s=0.1,
-    ),
-}
-MODEL_DEFAULTS["boom-panda"] = MODEL_DEFAULTS["boom7"]  # the same boom and a Panda of the same kinematics and mass
-GENERIC_DEFAULTS = ModelDefaults(law="acceleration")
+
+def defaults_for(model: str | FsmsModel) -> ModelDefaults:
+    """The app's defaults for a model (a loaded one, or a model key: its parameter file is read for them)."""
+    if isinstance(model, FsmsModel):
+        return defaults_from(model.spec.app, model.spec.base.joints, str(model.spec.param_path))
+    file = param_file_for(model)
+    return defaults_from(file.app, file.base.joints, model)
 
 
-def defaults_for(model: str) -> ModelDefaults:
-    """The defaults of a bundled model (by name or model key); a model from a parameter file gets generic ones."""
-    return MODEL_DEFAULTS.get(model_source(model), GENERIC_DEFAULTS)
+def defaults_from(app: AppTable, base_joints: tuple[str, ...], where: str) -> ModelDefaults:
+    """ModelDefaults from a parameter file's [app] table (``where`` names the file in an error)."""
+    gains = {}
+    for law in LAW_NAMES:
+        table = getattr(app.gains, law)
+        if table is not None:
+            gains[law] = _gains(table, f"{where}: [app.gains.{law}]")
+    return ModelDefaults(
+        law=app.law,
+        gains=gains,
+        kick_peak_N=app.kick_peak_N,
+        kick_duration_s=app.kick_duration_s,
+        kick_range_N=app.kick_range_N,
+        kick_axis=0 if app.kick_axis is None else base_joints.index(app.kick_axis),
+        exaggeration=MANUAL_EXAGGERATION if app.scene.exaggeration == "auto" else app.scene.exaggeration,
+        auto_exaggeration=app.scene.exaggeration == "auto",
+        target_speed_m_s=app.target_speed_m_per_s,
+        shown=frozenset(app.scene.shown),
+    )
+
+
+def _gains(table: LawGains, where: str) -> Gains:
+    """Gains from a table whose keys carry units (g_b_per_s -> g_b); a key left out keeps Gains' default."""
+    given = {key.rsplit("_per_", 1)[0]: getattr(table, key) for key in table.__struct_fields__}
+    try:
+        return Gains(**{name: value for name, value in given.items() if value is not None})
+    except InvalidGain as exc:
+        raise ModelFileError(f"{where}: {exc}") from None

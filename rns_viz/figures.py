@@ -1,4 +1,4 @@
-"""The paper's figures redrawn from our simulations (matplotlib, the optional ``figures`` extra).
+"""The paper's figures redrawn from our simulations (matplotlib).
 
 Each ``figN`` writes ``figN.png`` laid out like the paper's figure, axes in SI units;
 ``gain_map_<model>`` writes the gain map of the model's law in the paper (rns_viz.analysis).
@@ -25,13 +25,9 @@ if TYPE_CHECKING:
 
 
 def _pyplot() -> ModuleType:
-    """matplotlib.pyplot with the Agg backend, imported lazily (an optional dependency)."""
-    try:
-        import matplotlib
-    except ModuleNotFoundError:
-        raise ModuleNotFoundError(
-            "figures need matplotlib: pip install 'rns_viz[figures]'", name="matplotlib"
-        ) from None
+    """matplotlib.pyplot with the Agg backend, imported on first use (pyplot takes a second to load)."""
+    import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

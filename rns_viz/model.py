@@ -8,15 +8,17 @@ Jacobians); nothing is hand-derived.
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
 from rns_viz.params import ModelFileError, ModelSpec, load_spec, param_path_for, spec_for_key
+from rns_viz.rns import null_vector
+from rns_viz.urdf import build_pinocchio_model
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -37,6 +39,15 @@ class Terms:
     ee: np.ndarray  # (3,) end-effector position in the base frame, m
 
 
+class EndEffectorFrame(NamedTuple):
+    """The end effector at one configuration, in the base frame (:meth:`FsmsModel.ee_frame_jacobian`)."""
+
+    position: np.ndarray  # (3,) m
+    rotation: np.ndarray  # (3, 3)
+    linear: np.ndarray  # (3, n) m/rad: J, every axis (the task rows are FsmsModel.task_rows of it)
+    angular: np.ndarray  # (3, n) rad/rad: the angular rows of the frame Jacobian
+
+
 @dataclass(frozen=True)
 class ArmBranch:
     """One arm of a tree: its joints' indices into theta (pinocchio's order) and its end-effector frame."""
@@ -55,7 +66,7 @@ class FsmsModel:
 
     def __init__(self, spec: ModelSpec) -> None:
         self.spec = spec
-        self.pin_model = _build_pinocchio_model(spec)
+        self.pin_model = build_pinocchio_model(spec)
         self.data = self.pin_model.createData()
         model = self.pin_model
         self.m = spec.base.dof
@@ -84,7 +95,7 @@ class FsmsModel:
         self.arm_groups = _arm_branches(spec, self.arm_joint_names, model)
         self.selected = np.flatnonzero(spec.base.selection)
         # S's rows as a slice where they run together: a view of pinocchio's fresh M (crba returns a
-        # copy), 0.45 us where fancy indexing took 2.6 (boom7), in every reactionless-path step
+        # copy) instead of a fancy-indexed copy, in every reactionless-path step
         contiguous = len(self.selected) > 0 and bool(np.all(np.diff(self.selected) == 1))
         self._coupling_rows: slice | np.ndarray = (
             slice(int(self.selected[0]), int(self.selected[-1]) + 1) if contiguous else self.selected
@@ -178,6 +189,15 @@ class FsmsModel:
         """S H_bm: the rows of the inertia coupling matrix selected by S (Sec. III-B)."""
         return self.mass_matrix(q, data)[self._coupling_rows, self.m :]
 
+    def coupling_at(self, theta: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+        """S H_bm at the arm configuration theta with the base at rest in its equilibrium (x_b = 0)."""
+        return self.coupling_matrix(self.q(theta), data)
+
+    def null_vector(self, theta: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+        """n(theta) of a 1-D RNS (Eq. 27, generalised; :func:`rns_viz.rns.null_vector` of S H_bm), kg m: the
+        unnormalised direction of the reactionless path through theta."""
+        return null_vector(self.coupling_at(theta, data))
+
     def dynamics(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, the velocity terms c = (c_b, c_m) and H_bm' theta' at (q, v): what the laws need.
 
@@ -235,31 +255,53 @@ class FsmsModel:
         R = base.rotation
         return (R.T @ J_world)[rows], (R.T @ acc)[rows], R.T @ ee
 
-    def ee_position(self, theta: np.ndarray) -> np.ndarray:
-        """End-effector position in the base frame, m (forward kinematics by pinocchio)."""
-        q = self.q(theta)
-        pin.forwardKinematics(self.pin_model, self.data, q)
-        pin.updateFramePlacement(self.pin_model, self.data, self.ee_frame_id)
-        base = self.data.oMi[self.base_joint_id]
-        return base.rotation.T @ (self.data.oMf[self.ee_frame_id].translation - base.translation)
+    def _ee_placements(self, theta: np.ndarray, data: pin.Data | None) -> tuple[pin.SE3, pin.SE3]:
+        """The base frame and the end-effector frame in the world at (x_b = 0, theta), forward kinematics done."""
+        data = self.data if data is None else data
+        pin.forwardKinematics(self.pin_model, data, self.q(theta))
+        ee = pin.updateFramePlacement(self.pin_model, data, self.ee_frame_id)
+        return data.oMi[self.base_joint_id], ee
 
-    def arm_points(self, theta: np.ndarray) -> np.ndarray:
+    def ee_position(self, theta: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+        """End-effector position in the base frame, m (forward kinematics by pinocchio).
+
+        ``data``: pinocchio data to work in (default: the model's own, which the laws also use).
+        """
+        base, ee = self._ee_placements(theta, data)
+        return base.rotation.T @ (ee.translation - base.translation)
+
+    def ee_pose(self, theta: np.ndarray, data: pin.Data | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """End-effector position (3,), m, and orientation (3, 3) in the base frame."""
+        base, ee = self._ee_placements(theta, data)
+        R = base.rotation.T
+        return R @ (ee.translation - base.translation), R @ ee.rotation
+
+    def ee_frame_jacobian(self, theta: np.ndarray, data: pin.Data | None = None) -> EndEffectorFrame:
+        """The end effector's position, orientation and full (6, n) Jacobian in the base frame at theta, x_b = 0."""
+        model, m, frame = self.pin_model, self.m, self.ee_frame_id
+        data = self.data if data is None else data
+        J = pin.computeFrameJacobian(model, data, self.q(theta), frame, pin.LOCAL_WORLD_ALIGNED)[:, m:]
+        base, ee = data.oMi[self.base_joint_id], data.oMf[frame]  # both placed by computeFrameJacobian
+        R = base.rotation.T
+        return EndEffectorFrame(R @ (ee.translation - base.translation), R @ ee.rotation, R @ J[:3], R @ J[3:])
+
+    def arm_points(self, theta: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """Base-frame positions (n + 1, 3) of the arm joints and the end effector, m: the arm's polyline."""
-        q = self.q(theta)
-        pin.framesForwardKinematics(self.pin_model, self.data, q)
-        base = self.data.oMi[self.base_joint_id]
-        points = [self.data.oMi[i].translation for i in range(self.m + 1, self.pin_model.njoints)]
-        points.append(self.data.oMf[self.ee_frame_id].translation)
-        return (np.array(points) - base.translation) @ base.rotation
+        return self._polyline(theta, range(self.m + 1, self.pin_model.njoints), self.ee_frame_id, data)
 
-    def branch_points(self, theta: np.ndarray, arm: str) -> np.ndarray:
+    def branch_points(self, theta: np.ndarray, arm: str, data: pin.Data | None = None) -> np.ndarray:
         """Base-frame positions (k + 1, 3) of one arm's joints and its end-effector frame, m (a tree's polyline)."""
         branch = self.arm_groups[arm]
-        pin.framesForwardKinematics(self.pin_model, self.data, self.q(theta))
-        ids = [self.pin_model.getJointId(j) for j in branch.joints]
-        points = [self.data.oMi[i].translation for i in ids]
-        points.append(self.data.oMf[self.pin_model.getFrameId(branch.frame)].translation)
-        base = self.data.oMi[self.base_joint_id]
+        joints = [self.pin_model.getJointId(j) for j in branch.joints]
+        return self._polyline(theta, joints, self.pin_model.getFrameId(branch.frame), data)
+
+    def _polyline(self, theta: np.ndarray, joints: Sequence[int], frame: int, data: pin.Data | None) -> np.ndarray:
+        """Base-frame positions of ``joints`` and then of ``frame`` at (x_b = 0, theta), m."""
+        data = self.data if data is None else data
+        pin.framesForwardKinematics(self.pin_model, data, self.q(theta))
+        points = [data.oMi[i].translation for i in joints]
+        points.append(data.oMf[frame].translation)
+        base = data.oMi[self.base_joint_id]
         return (np.array(points) - base.translation) @ base.rotation
 
     def ee_positions(self, thetas: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
@@ -329,50 +371,3 @@ def _arm_branches(spec: ModelSpec, arm_joints: tuple[str, ...], model: pin.Model
         index = np.array([arm_joints.index(j) for j in joints])
         branches[name] = ArmBranch(tuple(joints), index, frame)
     return branches
-
-
-def check_urdf(path: Path) -> None:
-    """Structural checks with messages naming the element, before pinocchio (whose errors do not)."""
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        line, column = exc.position
-        raise ModelFileError(f"{path}: not well-formed XML at line {line}, column {column}") from None
-    if root.tag != "robot":
-        raise ModelFileError(f"{path}: the root element must be <robot>, got <{root.tag}>")
-    links = {link.get("name") for link in root.iter("link")}
-    for joint in root.iter("joint"):
-        name = joint.get("name")
-        kind = joint.get("type")
-        where = f"{path}: <joint name={name!r}>"
-        if kind not in ("revolute", "continuous", "prismatic", "fixed", "floating", "planar"):
-            raise ModelFileError(f"{where}: unknown type {kind!r}")
-        for tag in ("parent", "child"):
-            element = joint.find(tag)
-            if element is None or element.get("link") not in links:
-                link = None if element is None else element.get("link")
-                raise ModelFileError(f"{where}: <{tag} link={link!r}> names no <link> of this robot")
-        if kind in ("revolute", "prismatic") and joint.find("limit") is None:
-            raise ModelFileError(f"{where}: a {kind} joint needs a <limit> element")
-    for link in root.iter("link"):
-        mass = link.find("inertial/mass")
-        if mass is not None:
-            try:
-                value = float(mass.get("value", "nan"))
-            except ValueError:
-                value = float("nan")
-            if not (np.isfinite(value) and value >= 0):
-                raise ModelFileError(f"{path}: <link name={link.get('name')!r}> <mass value=...> must be >= 0")
-
-
-def _build_pinocchio_model(spec: ModelSpec) -> pin.Model:
-    path = spec.urdf_path
-    if not path.is_file():
-        raise ModelFileError(f"{spec.param_path}: [model] urdf: no file {path}")
-    check_urdf(path)
-    try:
-        model = pin.buildModelFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise ModelFileError(f"{path}: pinocchio cannot read this URDF ({str(exc).strip()})") from None
-    model.gravity.linear[:] = spec.gravity
-    return model

@@ -1,4 +1,4 @@
-"""Model parameter files: one TOML file per model, beside its URDF in ``assets/``.
+"""Model parameter files: one TOML file per model, beside its URDF (the bundled ones in ``rns_viz/assets``).
 
 The URDF holds geometry and mass (the single source for dynamics and drawing); the parameter
 file holds what a URDF cannot say: which joints are the elastic base coordinates x_b, their
@@ -7,6 +7,9 @@ damping D_m, the task axes of the end-effector Jacobian and the default configur
 arms branching from the base (``[arms]``) which joints form the task arm and the compensating arms.
 A file may take another file's tables as defaults (``extends = "boom7.toml"``, keys of its own win)
 and may name a packaged arm that replaces its URDF's arm (``[model] arm``, see :mod:`rns_viz.robots`).
+Its ``[app]`` table says how the live app offers the model (label, law and gains, kick, drawing, presets,
+lessons); a bundled model is a file in ``assets/`` with an ``[app]`` table of its own. Every table and
+key is typed and checked in :mod:`rns_viz.param_file`.
 
 Units are SI: K_b in N/m (prismatic base coordinate) or N m/rad (revolute), D_b in N s/m or
 N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends in ``_deg``.
@@ -14,28 +17,43 @@ N m s/rad, D_m in N m s/rad; angles in the file are degrees where the key ends i
 
 from __future__ import annotations
 
+import importlib.resources
 import math
-import tomllib
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from functools import cache
 from pathlib import Path
 
 import numpy as np
 
+from rns_viz.param_file import AppTable, ArmsTable, ModelFileError, ParamFile, own_tables, read_param_file
 from rns_viz.robots import RobotPackageMissing, composed_urdf, is_installed, packaged_arm
 
-ASSETS_DIR = Path(__file__).resolve().parent.parent / "assets"
-MODEL_NAMES = ("trep", "planar3r", "boom7", "trep2", "boom-panda")  # the bundled models the live app serves
-BUNDLED_MODELS = MODEL_NAMES  # every model in assets/, for FsmsModel.from_name
-# Bundled models whose arm comes from an optional package: name -> the packaged arm (rns_viz.robots).
-PACKAGED_MODELS = {"boom-panda": "example-robot-data/panda"}
+
+def _package_data(folder: str) -> Path:
+    """A folder of rns_viz's package data, found through :mod:`importlib.resources` wherever the
+    package is installed. Pinocchio and the parameter files' relative URDF names need real files, so
+    a package imported from a zip archive is refused with that reason."""
+    path = importlib.resources.files("rns_viz") / folder
+    if not isinstance(path, Path):
+        raise ImportError(f"rns_viz's {folder} are not files on disk ({path}); install rns_viz unzipped")
+    return path
+
+
+ASSETS_DIR = _package_data("assets")  # the bundled URDFs and parameter files
 SELECTION_MARK = "#S="  # a model key's selection suffix: "boom7#S=111000"
-TASK_AXES = ("x", "y", "z")
 
 
-class ModelFileError(ValueError):
-    """A URDF or parameter file that cannot be used; the message names the file and element."""
+def _bundled(folder: Path) -> tuple[str, ...]:
+    """The bundled models: the parameter files in ``folder`` with an [app] table of their own, in menu order."""
+    files = [path for path in folder.glob("*.toml") if "app" in own_tables(path)]
+    found = {path.stem: read_param_file(path).app.menu_order for path in files}
+    return tuple(sorted(found, key=lambda name: (found[name], name)))
+
+
+MODEL_NAMES = _bundled(ASSETS_DIR)  # the bundled models the live app serves
+BUNDLED_MODELS = MODEL_NAMES  # every model in assets/, for FsmsModel.from_name
 
 
 @dataclass(frozen=True)
@@ -78,6 +96,7 @@ class ModelSpec:
     base: BaseSpec
     joint_damping: np.ndarray  # D_m diagonal, N m s/rad
     arms: ArmGroups | None = None  # [arms]: None for a single serial arm
+    app: AppTable = field(default_factory=AppTable)  # [app]: how the live app offers the model
 
     def with_selection(self, selection: Sequence[int | bool]) -> ModelSpec:
         """The same system with another selection S (Sec. III-B): 0/1 flags over the m base coordinates."""
@@ -138,8 +157,10 @@ def spec_for_key(key: str) -> ModelSpec:
 
 
 def missing_extra(name: str) -> str | None:
-    """The optional extra a bundled model still needs (``"panda"``), or None when it can load."""
-    arm = PACKAGED_MODELS.get(model_source(name))
+    """The optional extra a bundled model still needs (``"panda"``: its packaged arm is not installed), or None
+    (a parameter file is read, and a missing arm refused with the install command, when the model loads)."""
+    source = model_source(name)
+    arm = _bundled_file(source).model.arm if source in BUNDLED_MODELS else None
     return None if arm is None or is_installed(arm) else packaged_arm(arm).extra
 
 
@@ -150,100 +171,56 @@ def param_path_for(name: str) -> Path:
     return ASSETS_DIR / f"{name}.toml"
 
 
-def _get(table: dict, key: str, where: str, path: Path) -> object:
-    if key not in table:
-        raise ModelFileError(f"{path}: missing [{where}] {key}")
-    return table[key]
+def source_path(key: str) -> Path:
+    """The parameter file a model key names (a bundled model's in ``assets/``)."""
+    source = model_source(check_model_key(key))
+    return param_path_for(source) if source in BUNDLED_MODELS else Path(source)
 
 
-def _matrix(value: object, shape: tuple[int, int], element: str, path: Path) -> np.ndarray:
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ModelFileError(f"{path}: {element} must be numbers ({exc})") from None
-    if arr.shape != shape:
-        raise ModelFileError(f"{path}: {element} must have shape {shape}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ModelFileError(f"{path}: {element} must be finite")
-    return arr
+def param_file_for(key: str) -> ParamFile:
+    """The checked parameter file a model key names (no URDF read): a bundled one once, a file each time."""
+    source = model_source(check_model_key(key))
+    return _bundled_file(source) if source in BUNDLED_MODELS else read_param_file(Path(source))
+
+
+@cache
+def _bundled_file(name: str) -> ParamFile:
+    return read_param_file(param_path_for(name))
 
 
 def load_spec(param_path: str | Path) -> ModelSpec:
-    """Read and check a parameter file; the URDF path inside is relative to the file."""
+    """Read and check a parameter file (rns_viz.param_file); the URDF path inside is relative to the file."""
     path = Path(param_path)
-    data = _read_toml(path)
-    parent = data.pop("extends", None)
-    if parent is not None:  # the other file's tables are defaults, key by key
-        if not isinstance(parent, str):
-            raise ModelFileError(f"{path}: extends must be a parameter file's name")
-        defaults = _read_toml(path.parent / parent)
-        defaults.pop("extends", None)  # one level: a chain of files would hide where a number comes from
-        for name, table in data.items():
-            if isinstance(table, dict) and isinstance(defaults.get(name), dict):
-                defaults[name] = {**defaults[name], **table}
-            else:
-                defaults[name] = table
-        data = defaults
-    model = _get(data, "model", "", path)
-    base = _get(data, "base", "", path)
-    arm = data.get("arm", {})
-    if not isinstance(model, dict) or not isinstance(base, dict) or not isinstance(arm, dict):
-        raise ModelFileError(f"{path}: [model], [base] and [arm] must be tables")
-
-    joints = _get(base, "joints", "base", path)
-    if not (isinstance(joints, list) and joints and all(isinstance(j, str) for j in joints)):
-        raise ModelFileError(f"{path}: [base] joints must be a non-empty list of joint names")
-    m = len(joints)
-    if m > 6:
-        raise ModelFileError(f"{path}: [base] joints: at most 6 elastic base coordinates, got {m}")
-    stiffness = _matrix(_get(base, "stiffness", "base", path), (m, m), "[base] stiffness", path)
-    damping = _matrix(base.get("damping", np.zeros((m, m)).tolist()), (m, m), "[base] damping", path)
-    selection = _matrix([base.get("selection", [1] * m)], (1, m), "[base] selection", path)[0]
-    if not np.all((selection == 0) | (selection == 1)) or not selection.any():
-        raise ModelFileError(f"{path}: [base] selection must be 0/1 flags with at least one 1")
-
-    theta0_deg = np.array(_get(model, "default_configuration_deg", "model", path), dtype=float)
-    n = theta0_deg.size
-    joint_damping = _matrix([arm.get("joint_damping", [0.0] * n)], (1, n), "[arm] joint_damping", path)[0]
-    axes = tuple(model.get("task_axes", ["x", "y"]))
-    if not axes or any(a not in TASK_AXES for a in axes) or len(set(axes)) != len(axes):
-        raise ModelFileError(f"{path}: [model] task_axes must be distinct names from {TASK_AXES}")
-    gravity = _matrix([model.get("gravity_m_per_s2", [0.0, 0.0, 0.0])], (1, 3), "[model] gravity_m_per_s2", path)[0]
-    urdf = _get(model, "urdf", "model", path)
-    if not isinstance(urdf, str):
-        raise ModelFileError(f"{path}: [model] urdf must be a file name")
-    if not np.all(np.isfinite(theta0_deg)):
-        raise ModelFileError(f"{path}: [model] default_configuration_deg must be finite")
-    urdf_path = (path.parent / urdf).resolve()
-    if "arm" in model:
-        urdf_path = _with_packaged_arm(urdf_path, model["arm"], path)
+    file = read_param_file(path)
+    model, base = file.model, file.base
+    m, n = len(base.joints), len(model.default_configuration_deg)
+    urdf_path = (path.parent / model.urdf).resolve()
+    if model.arm is not None:
+        urdf_path = _with_packaged_arm(urdf_path, model.arm, path)
     return ModelSpec(
-        name=str(model.get("name", path.stem)),
+        name=model.name or path.stem,
         urdf_path=urdf_path,
         param_path=path.resolve(),
-        ee_frame=str(_get(model, "ee_frame", "model", path)),
-        task_axes=axes,
-        default_configuration=np.deg2rad(theta0_deg),
-        gravity=gravity,
-        base=BaseSpec(tuple(joints), stiffness, damping, selection.astype(bool)),
-        joint_damping=joint_damping,
-        arms=_arm_groups(data.get("arms"), path),
+        ee_frame=model.ee_frame,
+        task_axes=tuple(model.task_axes),
+        default_configuration=np.deg2rad(np.array(model.default_configuration_deg, dtype=float)),
+        gravity=np.array(model.gravity_m_per_s2, dtype=float),
+        base=BaseSpec(
+            tuple(base.joints),
+            np.array(base.stiffness, dtype=float),
+            np.zeros((m, m)) if base.damping is None else np.array(base.damping, dtype=float),
+            np.ones(m, dtype=bool) if base.selection is None else np.array(base.selection, dtype=bool),
+        ),
+        joint_damping=np.zeros(n) if file.arm.joint_damping is None else np.array(file.arm.joint_damping, float),
+        arms=None if file.arms is None else _arm_groups(file.arms, path),
+        app=file.app,
     )
 
 
-def _read_toml(path: Path) -> dict:
-    try:
-        return tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise ModelFileError(f"{path}: cannot read ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelFileError(f"{path}: not valid TOML ({exc})") from None
-
-
-def _with_packaged_arm(urdf_path: Path, arm: object, path: Path) -> Path:
+def _with_packaged_arm(urdf_path: Path, arm: str, path: Path) -> Path:
     """[model] arm: the URDF with its arm replaced by a packaged robot's (composed now, cached)."""
     try:
-        return composed_urdf(urdf_path, str(arm))
+        return composed_urdf(urdf_path, arm)
     except KeyError as exc:
         raise ModelFileError(f"{path}: [model] arm: {exc.args[0]}") from None
     except RobotPackageMissing as exc:
@@ -252,29 +229,14 @@ def _with_packaged_arm(urdf_path: Path, arm: object, path: Path) -> Path:
         raise ModelFileError(f"{path}: [model] arm = {arm!r}: cannot compose the URDF ({exc})") from None
 
 
-def _names(value: object, element: str, path: Path) -> tuple[str, ...]:
-    if not (isinstance(value, list) and value and all(isinstance(v, str) for v in value)):
-        raise ModelFileError(f"{path}: {element} must be a non-empty list of joint names")
-    return tuple(value)
-
-
-def _arm_groups(table: object, path: Path) -> ArmGroups | None:
+def _arm_groups(table: ArmsTable, path: Path) -> ArmGroups:
     """[arms]: task = [...], compensating = [...] (or a list of such lists), ee_frames = {...}."""
-    if table is None:
-        return None
-    if not isinstance(table, dict):
-        raise ModelFileError(f"{path}: [arms] must be a table")
-    task = _names(_get(table, "task", "arms", path), "[arms] task", path)
-    raw = _get(table, "compensating", "arms", path)
-    groups = raw if isinstance(raw, list) and raw and all(isinstance(g, list) for g in raw) else [raw]
-    compensating = tuple(_names(g, "[arms] compensating", path) for g in groups)
-    every = [*task, *(j for g in compensating for j in g)]
+    raw = table.compensating
+    compensating = tuple(tuple(g) for g in raw) if isinstance(raw[0], tuple) else (tuple(raw),)
+    every = [*table.task, *(j for g in compensating for j in g)]
     if len(set(every)) != len(every):
         raise ModelFileError(f"{path}: [arms] a joint belongs to two arms")
-    frames = table.get("ee_frames", {})
-    if not isinstance(frames, dict) or not all(isinstance(v, str) for v in frames.values()):
-        raise ModelFileError(f"{path}: [arms] ee_frames must map arm names to frame names")
-    return ArmGroups(task, compensating, dict(frames))
+    return ArmGroups(tuple(table.task), compensating, dict(table.ee_frames))  # type: ignore[arg-type]
 
 
 def natural_frequency_hz(stiffness: float, mass: float) -> float:

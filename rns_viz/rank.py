@@ -110,7 +110,7 @@ def rank_deficient_configurations(
 
 
 def kernel_coupling(model: FsmsModel, theta: np.ndarray, columns: Sequence[int] | None = None) -> tuple[float, float]:
-    """|S H_bm v| for a unit joint velocity v along the kernel of S H_bm[:, columns], and sigma_max there.
+    """``|S H_bm v|`` for a unit joint velocity v along the kernel of S H_bm[:, columns], and sigma_max there.
 
     The kernel direction is the right singular vector of the smallest singular value (any direction
     where the matrix vanishes). Rows weighted as :func:`rns_viz.rns.singularity_distance`: kg m per rad/s.

@@ -1,4 +1,6 @@
-"""Reaction null-space maths (Sec. III): damped inverse, P_RNS, n, restricted Jacobian, Lie brackets.
+"""Reaction null-space maths (Sec. III): damped inverse, P_RNS, n, restricted Jacobian, the distance to
+singularity, and the one RK4 step that integrates a field of the RNS distribution (n, n u-bar, P_RNS v).
+Whether the distribution is integrable (Lie brackets): :mod:`rns_viz.integrability`.
 
 Pure numpy on matrices that the model supplies; no pinocchio, no viser.
 """
@@ -8,8 +10,8 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from functools import cache
+from typing import Any
 
 import numpy as np
 
@@ -168,7 +170,7 @@ def damped_row_pinv(
     a: list[float], threshold: float = DEFAULT_THRESHOLD, max_damping: float = DEFAULT_MAX_DAMPING
 ) -> DampedInverse:
     """:func:`damped_pinv` of the one-row matrix [a] given as Python floats (a 1-DOF base, per step):
-    the column a / (|a|^2 + lambda^2), sigma = |a|. No SVD, no numpy call."""
+    the column ``a / (|a|^2 + lambda^2)``, ``sigma = |a|``. No SVD, no numpy call."""
     sigma2 = sum(map(operator.mul, a, a))
     sigma = math.sqrt(sigma2)
     lam2 = _damping_squared(sigma, threshold, max_damping)
@@ -204,24 +206,68 @@ def _two_rows(A: np.ndarray, threshold: float, max_damping: float) -> DampedInve
 def rns_projector(H_bm: np.ndarray, H_bm_pinv: np.ndarray | None = None, *, rank_tol: float = 1e-12) -> np.ndarray:
     """P_RNS = E - H_bm^+ H_bm, the projector onto the reaction null space (Eqs. 9, 10).
 
+    ``H_bm``: one (r, n) matrix, or a stack (..., r, n) for as many configurations (P is then (..., n, n)).
     ``H_bm_pinv``: the inverse to use, e.g. the damped one the laws use (:func:`damped_pinv`);
     by default the Moore-Penrose inverse, for which H_bm^+ H_bm = V_r V_r^T with V_r the SVD's
     row-space basis: P is then exactly symmetric and idempotent.
     """
     H = np.atleast_2d(np.asarray(H_bm, dtype=float))
+    E = np.eye(H.shape[-1])
     if H_bm_pinv is not None:
-        return np.eye(H.shape[1]) - H_bm_pinv @ H
+        return E - H_bm_pinv @ H
     _, s, Vt = np.linalg.svd(H)
-    rank = int(np.sum(s > rank_tol * max(1.0, s[0] if s.size else 0.0)))
-    range_basis = Vt[:rank]
-    return np.eye(H.shape[1]) - range_basis.T @ range_basis
+    if H.ndim == 2:
+        rank = int(np.sum(s > rank_tol * max(1.0, s[0] if s.size else 0.0)))
+        range_basis = Vt[:rank]
+        return E - range_basis.T @ range_basis
+    kept = s > rank_tol * np.maximum(1.0, s[..., :1])  # (..., r): each matrix's own rank
+    range_basis = Vt[..., : s.shape[-1], :] * kept[..., None]
+    return E - np.swapaxes(range_basis, -1, -2) @ range_basis
 
 
-def project_onto_rns(u: np.ndarray, H_bm: np.ndarray, H_bm_pinv: np.ndarray) -> np.ndarray:
-    """P_RNS u = u - H_bm^+ (H_bm u): :func:`rns_projector` applied to one vector, P never formed."""
+def project_onto_rns(u: np.ndarray, H_bm: np.ndarray, H_bm_pinv: np.ndarray | None = None) -> np.ndarray:
+    """P_RNS u = u - H_bm^+ (H_bm u): :func:`rns_projector` applied to a vector, P never formed.
+
+    One vector u (n,) with H_bm (r, n), or a stack u (K, n) with H_bm (K, r, n), one per configuration.
+    ``H_bm_pinv``: the inverse the laws use (one matrix); None: the Moore-Penrose inverse of a full-row-rank
+    H_bm, H_bm^T (H_bm H_bm^T)^-1, by one solve per configuration.
+    """
+    if H_bm_pinv is None:
+        Hu = np.einsum("...rn,...n->...r", H_bm, u)
+        multipliers = np.linalg.solve(H_bm @ np.swapaxes(H_bm, -1, -2), Hu[..., None])[..., 0]
+        return u - np.einsum("...rn,...r->...n", H_bm, multipliers)
     if H_bm_pinv.shape[1] == 1:  # one coupling row: a scalar times the inverse column
         return u - H_bm_pinv[:, 0] * H_bm[0].dot(u)
     return u - H_bm_pinv @ (H_bm @ u)
+
+
+def rns_basis(H_bm: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of the reaction null space N(S H_bm) of full row rank r: (n, n - r), or (..., n, n - r)
+    for a stack; the SVD's right singular vectors beyond the rows (the columns span what P_RNS projects onto)."""
+    Vt = np.linalg.svd(H_bm)[2]
+    return np.swapaxes(Vt[..., H_bm.shape[-2] :, :], -1, -2)
+
+
+def rk4_along(
+    field: Callable[[Any, np.ndarray], np.ndarray],
+    s: Any,
+    x: np.ndarray,
+    h: Any,
+    k1: np.ndarray | None = None,
+) -> np.ndarray:
+    """x(s + h) by one classical Runge-Kutta step of dx/ds = field(s, x) from (s, x).
+
+    The one integrator along a field of the RNS distribution: a reactionless path d theta/ds = n (Eq. 27, in
+    arc length or in sigma), Eq. (30)'s reference theta_ref' = n u-bar(t), a move along P_RNS v. x may be a
+    stack (K, n) with h (K, 1), K curves in lock-step. ``k1``: field(s, x), when the caller has it already.
+    """
+    if k1 is None:
+        k1 = field(s, x)
+    half = 0.5 * h
+    k2 = field(s + half, x + half * k1)
+    k3 = field(s + half, x + half * k2)
+    k4 = field(s + h, x + h * k3)
+    return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
 def null_vector(H_bm: np.ndarray) -> np.ndarray:
@@ -258,58 +304,3 @@ def _minor_columns(cols: int) -> np.ndarray:
 def restricted_jacobian(J: np.ndarray, P_rns: np.ndarray) -> np.ndarray:
     """J-bar = J P_RNS, the restricted Jacobian of Eq. (22)."""
     return J @ P_rns
-
-
-@dataclass(frozen=True)
-class Integrability:
-    """Result of the Frobenius test: is the RNS distribution involutive at the sampled points?"""
-
-    integrable: bool
-    max_residual: float  # largest |(E - P) [X_i, X_j]| / (|X_i| |X_j|) over samples and pairs
-    samples: int
-    rns_dim: int
-
-
-def lie_bracket(
-    X: Callable[[np.ndarray], np.ndarray], Y: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, eps: float = 1e-6
-) -> np.ndarray:
-    """[X, Y](theta) = DY X - DX Y, Jacobians by central differences."""
-    n = theta.size
-    DX = np.empty((n, n))
-    DY = np.empty((n, n))
-    for k in range(n):
-        d = np.zeros(n)
-        d[k] = eps
-        DX[:, k] = (X(theta + d) - X(theta - d)) / (2 * eps)
-        DY[:, k] = (Y(theta + d) - Y(theta - d)) / (2 * eps)
-    return DY @ X(theta) - DX @ Y(theta)
-
-
-def check_integrability(
-    coupling: Callable[[np.ndarray], np.ndarray], samples: np.ndarray, tol: float = 1e-6
-) -> Integrability:
-    """Frobenius test of the distribution spanned by the columns of P_RNS (Sec. III-A).
-
-    ``coupling(theta)`` returns S H_bm. The distribution is involutive where every bracket of
-    two columns of P_RNS lies in it again, i.e. (E - P_RNS)[P_i, P_j] = 0. A 1-D distribution
-    (n - m = 1) always passes.
-    """
-
-    def column(j: int) -> Callable[[np.ndarray], np.ndarray]:
-        return lambda th: rns_projector(coupling(th))[:, j]
-
-    worst = 0.0
-    rns_dim = 0
-    for theta in np.atleast_2d(samples):
-        P = rns_projector(coupling(theta))
-        rns_dim = round(float(np.trace(P)))
-        n = theta.size
-        for i in range(n):
-            for j in range(i + 1, n):
-                Xi, Xj = P[:, i], P[:, j]
-                scale = np.linalg.norm(Xi) * np.linalg.norm(Xj)
-                if scale < 1e-6:
-                    continue
-                bracket = lie_bracket(column(i), column(j), theta)
-                worst = max(worst, float(np.linalg.norm(bracket - P @ bracket)) / scale)
-    return Integrability(bool(worst < tol), worst, len(np.atleast_2d(samples)), rns_dim)

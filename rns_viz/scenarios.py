@@ -5,14 +5,14 @@ redundancy on trep2 (Sec. III-B: a compensating second arm).
 Each preset builds a ready :class:`Simulator` with the paper's parameters. Choices the paper
 leaves open are documented at the constants below. The boom7 presets are in SPATIAL_SCENARIOS and the
 same experiments with the Franka Panda on that boom (boom-panda) in PANDA_SCENARIOS; trep2's are in
-DUAL_SCENARIOS; the live app offers all of them (LIVE_SCENARIOS);
-``run_scenario`` runs all of them.
+DUAL_SCENARIOS; the live app offers all of them (LIVE_SCENARIOS), each model those its parameter file
+names (``[app] presets``, :func:`presets_for`); ``run_scenario`` runs all of them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 
 import numpy as np
@@ -34,8 +34,9 @@ from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.reference import path_integral_to
 from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
+from rns_viz.param_file import ModelFileError, unknown
+from rns_viz.params import param_file_for, source_path
 from rns_viz.profiles import CyclicUbar, QuinticUbar
-from rns_viz.rns import null_vector
 from rns_viz.sim import ForcePulse, Simulator
 
 # "An arbitrary external force" (Sec. VII-D): the kicks of rns_viz.defaults (why these sizes: there).
@@ -69,6 +70,7 @@ class Scenario:
     duration: float  # s
     description: str
     build: Callable[[], Simulator]
+    look: str = ""  # what to watch on screen while it runs (plain words; the app shows it)
 
 
 def _trep() -> FsmsModel:
@@ -212,7 +214,7 @@ def boom7_kick(suppress: bool, name: str = "boom7") -> Simulator:
 def boom7_path_reference(model: FsmsModel) -> PathReference:
     """theta_ref' = n u-bar along the r = 6 reactionless path from theta_0, quintic u-bar (Eq. 30's integral)."""
     theta0 = model.spec.default_configuration
-    sigma = BOOM7_PATH_ARC / float(np.linalg.norm(null_vector(model.coupling_matrix(model.q(theta0)))))
+    sigma = BOOM7_PATH_ARC / float(np.linalg.norm(model.null_vector(theta0)))
     return PathReference(model, theta0, QuinticUbar(sigma, BOOM7_MOVE_S, start=BOOM7_START_S))
 
 
@@ -251,6 +253,15 @@ def boom7_point_to_point(selection: tuple[int, ...] = FORCES_ONLY, name: str = "
     return Simulator(model, JointServo(model, BOOM7_GAINS, quintic))
 
 
+BOOM_LOOK = {  # what to watch in each boom preset
+    "kick-on": "all six tip deflections (Base coordinates plot) die out; the ghost (suppression off) keeps ringing.",
+    "kick-off": "joints held: the boom tip rings in all six directions.",
+    "path": "the hand moves along the one reaction-free direction; the boom tip stays below a micrometre.",
+    "track": "the hand moves in 3-D; the tip's forces stay near zero, its twists (moments) need not.",
+    "p2p": "the same end points by a joint-space motion: the boom tip shakes.",
+}
+
+
 def boom_scenarios(name: str) -> dict[str, Scenario]:
     """The boom's five presets for one of BOOMS, named after it (boom7-path, boom-panda-path, ...)."""
     presets = (
@@ -261,7 +272,7 @@ def boom_scenarios(name: str) -> dict[str, Scenario]:
         ("p2p", 3.0, "same end points, joint-space quintic", lambda: boom7_point_to_point(name=name)),
     )
     return {
-        f"{name}-{key}": Scenario(f"{name}-{key}", name, duration, f"{name}: {what}", build)
+        f"{name}-{key}": Scenario(f"{name}-{key}", name, duration, f"{name}: {what}", build, BOOM_LOOK[key])
         for key, duration, what, build in presets
     }
 
@@ -314,8 +325,41 @@ DUAL_SCENARIOS: dict[str, Scenario] = {
         ),
     )
 }
-ALL_SCENARIOS: dict[str, Scenario] = {**SCENARIOS, **SPATIAL_SCENARIOS, **PANDA_SCENARIOS, **DUAL_SCENARIOS}
+# What to watch in each of the paper's and trep2's presets (the boom's: BOOM_LOOK).
+PRESET_LOOK = {
+    "fig3": "the base vibration rings after the kick at 1 s and dies out once suppression starts at 3 s.",
+    "fig4": "the hand moves 0.71 m in a straight line while the base vibration plot stays near zero.",
+    "fig10-on": "after the kick the arm moves against the swing and the base vibration dies out in a few seconds; "
+    "the ghost (suppression off) keeps swinging.",
+    "fig10-off": "with the joints held nothing damps the base: its vibration keeps the same size.",
+    "fig11-slow": "link 2 folds back, yet the base stays still: micrometres (read the factor written beside the base).",
+    "fig11-fast": "the same path twice as fast: the base still moves only micrometres (2.8 µm in the paper); "
+    "compare fig11-joint2.",
+    "fig11-joint2": "the same end points with joint 2 turning alone: the base swings by about a millimetre, "
+    "hundreds of times more than fig11-fast.",
+    "fig12-on": "the arm goes round the path without shaking the base; the kick at 4 s dies out while the "
+    "motion goes on.",
+    "fig12-off": "the kick at 4 s leaves the base swinging while the arm keeps going round.",
+    "trep2-circle-on": "the task arm draws a circle; the second arm moves so that the beam stays still.",
+    "trep2-circle-off": "the same circle with the second arm held still: the beam swings.",
+    "trep2-kick-on": "after the kick the second arm damps the beam's swing while the task arm's hand stays put.",
+    "trep2-kick-off": "the second arm only cancels the task arm's push: the kicked beam keeps swinging.",
+}
+ALL_SCENARIOS: dict[str, Scenario] = {
+    name: replace(s, look=PRESET_LOOK.get(name, s.look))
+    for name, s in {**SCENARIOS, **SPATIAL_SCENARIOS, **PANDA_SCENARIOS, **DUAL_SCENARIOS}.items()
+}
 LIVE_SCENARIOS: dict[str, Scenario] = dict(ALL_SCENARIOS)  # the app's presets
+
+
+def presets_for(key: str) -> tuple[str, ...]:
+    """The presets a model offers in the app (its parameter file's ``[app] presets``); each runs as written, on
+    the model it was written for. ModelFileError (a ValueError) for a name no preset has."""
+    names = param_file_for(key).app.presets
+    for name in names:
+        if name not in LIVE_SCENARIOS:
+            raise ModelFileError(f"{source_path(key)}: [app] presets: {unknown(name, list(LIVE_SCENARIOS), 'preset')}")
+    return names
 
 
 def run_scenario(name: str, duration: float | None = None) -> Simulator:

@@ -5,12 +5,14 @@ for a parametrised name; boom-panda skips without its extra, and ``panda_not_ins
 Folders are levels: ``unit`` (pure functions and physics: the developer's loop, ``python -m pytest
 tests/unit``), ``session`` (a headless Session), ``app`` (a viser server, protocol clients), ``browser``
 (Chromium). Each test gets its folder's marker, so ``-m unit`` works from anywhere; a browser test also
-gets the browser's skip-or-fail rule and the "live" xdist group (one wall-clock test at a time,
-tests/support/browser.py). The fixtures of one level live in its folder's conftest.py.
+gets the browser's skip-or-fail rule (tests/support/browser.py). The fixtures of one level live in its
+folder's conftest.py.
 """
 
 from __future__ import annotations
 
+import os
+import sys
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -25,6 +27,18 @@ LEVELS = ("unit", "session", "app", "browser")
 TESTS = Path(__file__).resolve().parent
 
 
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int | None:
+    """``-n auto`` (pyproject's addopts): a worker per core, and one more when the run goes beyond tests/unit.
+    The session, app and browser tests spend much of their time waiting (for simulated time in real time, a
+    page, a helper process); the extra worker computes meanwhile. PYTEST_XDIST_AUTO_NUM_WORKERS still rules."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None  # xdist's own hook reads it
+    cores = len(os.sched_getaffinity(0))
+    unit = TESTS / "unit"
+    paths = [Path(str(arg).split("::")[0]).resolve() for arg in config.args] or [TESTS]
+    return cores if all(path.is_relative_to(unit) for path in paths) else cores + 1
+
+
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the groups and -m selects by marker
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
@@ -37,9 +51,16 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
                 item.add_marker(mark)
 
 
+def pytest_sessionfinish() -> None:
+    """Close the test process's shared Chromium, if a browser test started one (tests/support/browser.py)."""
+    browser = sys.modules.get("tests.support.browser")
+    if browser is not None:
+        browser.CHROMIUMS.close()
+
+
 def _browser_marks() -> list[pytest.MarkDecorator]:
-    """The browser marker, its skip-or-fail rule and the "live" group (imported only when browser tests
-    are collected: Playwright and the app are not needed below that level)."""
+    """The browser marker and its skip-or-fail rule (imported only when browser tests are collected:
+    Playwright and the app are not needed below that level)."""
     from tests.support.browser import browser_marks
 
     return browser_marks

@@ -1,4 +1,4 @@
-"""Gain analysis (issue 10): the closed loop of the simulator linearised in the gains (g_b, g_m).
+"""Gain analysis: the closed loop of the simulator linearised in the gains (g_b, g_m).
 
 - :func:`linearise` -> :class:`LinearLoop`, A(g_b, g_m) = A0 + g_b A_b + g_m A_m about a rest configuration;
 - :func:`modes_of` -> :class:`Modes`, poles split into the base group and the arm group;

@@ -64,7 +64,7 @@ def authority(loops: list[LinearLoop], g_b: float, g_m: float) -> Authority:
 
 @dataclass(frozen=True)
 class DecayFit:
-    """An exponential envelope A e^(-rate t) fitted to |x|; ``rate`` < 0 means growth."""
+    """An exponential envelope A e^(-rate t) fitted to ``|x|``; ``rate`` < 0 means growth."""
 
     rate: float  # 1/s
     amplitude: float  # units of x at t = 0 of the log
@@ -74,11 +74,11 @@ class DecayFit:
 
 
 def fit_decay(t: np.ndarray, x: np.ndarray, start: float | None = None, floor: float = 1e-3) -> DecayFit:
-    """Decay rate (1/s) of the envelope of |x(t)| from ``start`` (s; default the first sample).
+    """Decay rate (1/s) of the envelope of ``|x(t)|`` from ``start`` (s; default the first sample).
 
-    The local maxima of |x| above ``floor`` times the largest are fitted by a straight line in
-    log |x| (least squares); with fewer than three such peaks and no sign change after the largest
-    |x| (an overdamped decay) the samples after it above the floor are fitted instead. ValueError if
+    The local maxima of ``|x|`` above ``floor`` times the largest are fitted by a straight line in
+    ``log |x|`` (least squares); with fewer than three such peaks and no sign change after the largest
+    ``|x|`` (an overdamped decay) the samples after it above the floor are fitted instead. ValueError if
     neither applies (fewer than three swings: the log is too short for the oscillation).
     """
     t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
@@ -116,7 +116,7 @@ class KickMeasure:
 def measure_kick(t: np.ndarray, y: np.ndarray, kick_end: float, quiet: float | None = None) -> KickMeasure:
     """Peak, time to 10 % and decay of a deflection y(t) logged from a kick's start; ``kick_end`` in s.
 
-    The time to 10 % counts once |y| has stayed under 10 % of its peak for ``quiet`` s at the end of the
+    The time to 10 % counts once ``|y|`` has stayed under 10 % of its peak for ``quiet`` s at the end of the
     log (default: as long as it took to get there, at least a second): a swing may still come back."""
     t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
     a = np.abs(y)

@@ -7,9 +7,8 @@ speaks for it); a locus is the closed-loop poles as one gain sweeps with the oth
 
 from __future__ import annotations
 
-import csv
-import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import IO, Literal
 
 import numpy as np
@@ -18,6 +17,7 @@ from rns_viz.analysis.kick import Kick
 from rns_viz.analysis.linear import LinearLoop, StateView, law_kind, linearise
 from rns_viz.analysis.modes import Modes, modes_of
 from rns_viz.control import Gains, LawKind
+from rns_viz.csvio import write_csv
 from rns_viz.model import FsmsModel
 
 GRID_SIZE = 60
@@ -52,20 +52,21 @@ PAPER_GAINS: dict[tuple[str, LawKind], tuple[PaperGains, ...]] = {
     ("planar3r", "acceleration"): (PaperGains("Fig. 3", 10.0, 1.0),),
 }
 
-CSV_COLUMNS = (
-    "g_b",  # 1/s
-    "g_m",  # 1/s
-    "base_decay_rate_per_s",
-    "arm_decay_rate_per_s",
-    "base_damping_ratio",
-    "stable",
-    "base_time_to_10pct_s",
-    "arm_time_to_10pct_s",
-    "base_frequency_rad_per_s",
-    "predictable",
-    "arm_swing_rad",
-    "not_predictable_because",
-)
+# The map's CSV: column name -> unit. After g_b and g_m, each column is the Modes attribute of its name.
+CSV_COLUMNS: dict[str, str] = {
+    "g_b": "1/s",
+    "g_m": "1/s",
+    "base_decay_rate": "1/s",  # sigma_b = ln 10 / base_time_to_10pct (growing loop: its fastest growth, negative)
+    "arm_decay_rate": "1/s",  # sigma_a, the slowest decay of the modes under 5 % of the kick's peak (nan if none)
+    "base_damping_ratio": "1",  # of the pole that carries the deflection as it passes 10 % (1 if real)
+    "stable": "1 = stable",  # every mode decays
+    "base_time_to_10pct": "s",  # after the kick's end until |x_b| stays under 10 % of its peak (inf if it grows)
+    "arm_time_to_10pct": "s",  # ln 10 / sigma_a
+    "base_frequency": "rad/s",  # |Im lambda| of that pole
+    "predictable": "1 = predictable",  # the kick's response stays in the linear range (else the map hatches it)
+    "swing": "rad",  # the joints' largest swing outside the RNS while absorbing the kick
+    "reason": "code",  # why not predictable: 0 it is, 1 swing too large, 2 a joint limit, 3 decays within the kick
+}
 
 
 def default_axes(law: LawKind | str, n: int = GRID_SIZE) -> tuple[np.ndarray, np.ndarray]:
@@ -115,36 +116,13 @@ class GainMap:
         i, j = np.unravel_index(int(np.argmax(rate)), rate.shape)
         return float(self.g_b[i]), float(self.g_m[j]), float(rate[i, j])
 
-    def write_csv(self, handle: IO[str]) -> int:
-        """One row per grid point (g_b varies slowest), columns :data:`CSV_COLUMNS`; returns the rows."""
-        m = self.modes
-        columns = (
-            m.base_decay_rate,
-            m.arm_decay_rate,
-            m.base_damping_ratio,
-            m.stable,
-            m.base_time_to_10pct,
-            m.arm_time_to_10pct,
-            m.base_frequency,
-            m.predictable,
-            m.swing,
-        )
-        writer = csv.writer(handle)
-        writer.writerow(CSV_COLUMNS)
-        rows = 0
-        for i, g_b in enumerate(self.g_b):
-            for j, g_m in enumerate(self.g_m):
-                values = [_cell(c[i, j]) for c in columns]
-                writer.writerow([repr(float(g_b)), repr(float(g_m)), *values, m.why_not((i, j))])
-                rows += 1
-        return rows
-
-
-def _cell(value: np.generic) -> str:
-    if isinstance(value, np.bool_ | bool):
-        return str(int(value))
-    x = float(value)
-    return "inf" if math.isinf(x) else ("nan" if math.isnan(x) else f"{x:.6g}")
+    def write_csv(self, target: str | Path | IO[str]) -> int:
+        """One row per grid point (g_b varies slowest), columns :data:`CSV_COLUMNS` with their units
+        (rns_viz.csvio); returns the rows."""
+        g_b, g_m = np.meshgrid(self.g_b, self.g_m, indexing="ij")
+        values = [g_b, g_m, *(getattr(self.modes, name) for name in list(CSV_COLUMNS)[2:])]
+        rows = np.column_stack([np.asarray(v, dtype=float).ravel() for v in values])
+        return write_csv(target, list(CSV_COLUMNS), list(CSV_COLUMNS.values()), rows)
 
 
 def map_of(loop: LinearLoop, g_b: np.ndarray | None = None, g_m: np.ndarray | None = None) -> GainMap:

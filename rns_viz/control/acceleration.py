@@ -31,11 +31,26 @@ def composite_acceleration(cp: Coupling, g_b: float, g_m: float, null: NullOutpu
     return _any_coupling_rows(cp, g_b, g_m, null)
 
 
+def base_rows_demand(cp: Coupling, g_b: float, g_m: float, *, in_floats: bool = False) -> np.ndarray | float:
+    """y of Eq. (15), theta'' = H_bm^+ y + P_RNS u: the S H_bm theta'' it demands, with S on the rows of H_b,
+
+        y = g_b S H_b x_b' - S H_bm' theta' - g_m L,   L = S H_bm theta' (Eq. 8),
+
+    so that d(S L)/dt = S H_bm' theta' + S H_bm theta'' = g_b S H_b x_b' - g_m S L, and with Eq. (1)'s base
+    rows S [H_b (x_b'' + G_b x_b') + D_b x_b' + K_b x_b] = 0 (Eq. 13). S H_b x_b' (:attr:`Coupling.base_momentum`)
+    takes every base velocity: S H_b S^T S x_b' would drop what the free coordinates' motion couples into the
+    selected rows (documentation: models, boom7 in the app). An (r,) array; ``in_floats`` with a 1-DOF base's
+    row in Python floats at hand (``cp.row``, per step): y as one float from them.
+    """
+    row = cp.row
+    if in_floats and row is not None:
+        return g_b * row.H_b * row.xdot_b - row.hbm_dot_thetadot - g_m * row.L
+    return g_b * cp.base_momentum - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum
+
+
 def _any_coupling_rows(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
-    """Eq. (15) for any number of coupling rows, as written above, with S on the rows of H_b:
-    S H_b G_b x_b' (:attr:`Coupling.base_momentum`), so that S [H_b (x_b'' + G_b x_b') + K_b x_b] = 0 (Eq. 13)."""
-    y = g_b * cp.base_momentum - cp.hbm_dot_thetadot - g_m * cp.coupling_momentum
-    return cp.H_bm_pinv @ y + null.in_rns(cp)
+    """Eq. (15) for any number of coupling rows, as written above (:func:`base_rows_demand`)."""
+    return cp.H_bm_pinv @ base_rows_demand(cp, g_b, g_m) + null.in_rns(cp)
 
 
 def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) -> np.ndarray:
@@ -48,7 +63,7 @@ def _one_coupling_row(cp: Coupling, g_b: float, g_m: float, null: NullOutput) ->
     """
     row = cp.row
     g_u = null.damping
-    y = g_b * row.H_b * row.xdot_b - row.hbm_dot_thetadot - (g_m - g_u) * row.L
+    y = base_rows_demand(cp, g_b, g_m - g_u, in_floats=True)
     h, thetadot = row.h, row.thetadot
     if null.u is None:
         alpha = y * cp.inverse.row_scale

@@ -197,7 +197,7 @@ class Coupling:
         """(r,) S H_b x_b': the selected rows of H_b times all m base velocities (kg m/s, kg m^2/s).
 
         S selects rows only (Sec. III-B): the free components' velocities enter through H_b's
-        off-diagonal block, which S H_b S^T x_b' would drop (see README, forces-only suppression)."""
+        off-diagonal block, which S H_b S^T x_b' would drop (documentation: models, boom7 in the app)."""
         return self.M[self._rows, : self._m].dot(self._v[: self._m])
 
     @property

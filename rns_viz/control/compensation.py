@@ -6,9 +6,10 @@ theta_1 the task arm's joints and theta_2 the compensator's, and S H_bm = [S H_b
 - Task arm: ordinary resolved-acceleration tracking, no reactionless restriction,
       theta_1'' = J_1^+ (x_d'' + G_d e' + G_p e - J' theta'),  e = x_d - x_e.
 - Compensating arm: the base rows of Eq. (1) with the paper's inversion (9)-(10) for theta_2,
-      theta_2'' = H_bm,2^+ (H_b G_b x_b' - H_bm' theta' - G_m L - H_bm,1 theta_1'') + P_2 u_2,
-  L = S (H_bm,1 theta_1' + H_bm,2 theta_2') (Eq. 8), so that S H_bm theta'' + S H_bm' theta' = H_b G_b x_b'
-  - G_m L: with G_b = 0 the coupling momentum stays zero (Eq. 10 with L_0 = 0) and -G_m L
+      theta_2'' = H_bm,2^+ (S H_b G_b x_b' - S H_bm' theta' - G_m L - S H_bm,1 theta_1'') + P_2 u_2,
+  L = S (H_bm,1 theta_1' + H_bm,2 theta_2') (Eq. 8), so that S H_bm theta'' + S H_bm' theta' = S H_b G_b x_b'
+  - G_m L, Eq. (15)'s right-hand side (:func:`~rns_viz.control.acceleration.base_rows_demand`, S on the rows
+  of H_b: every base velocity): with G_b = 0 the coupling momentum stays zero (Eq. 10 with L_0 = 0) and -G_m L
   removes any drift; G_b is vibration suppression (15) through the compensator alone (law (30) is
   the integral of the same term for velocity-commanded drives; not provided here).
   P_2 = E - H_bm,2^+ H_bm,2 (Eq. 9) and u_2 climbs ln(sigma_2^2 + eps^2) + limit barriers: the
@@ -27,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from rns_viz.control.acceleration import base_rows_demand
 from rns_viz.control.common import ControlOutput, CouplingEvaluator, Gains, LawKind, realize_acceleration
 from rns_viz.control.null_input import TaskReference
 from rns_viz.control.reference import ReferenceSample, TaskSample
@@ -199,7 +201,7 @@ class CompensatingLaw:
         thetadot2 = v[self._cols]
         if self.compensate:
             g_b = g.g_b if self.suppress else 0.0
-            y = g_b * (cp.H_b @ cp.xdot_b) - cp.hbm_dot_thetadot - g.g_m * cp.coupling_momentum - H1 @ acc1
+            y = base_rows_demand(cp, g_b, g.g_m) - H1 @ acc1  # Eq. (15)'s, less what the task arm takes
             if self._grad is None or not 0.0 <= t - self._grad_t < AVOID_EVERY_S - 1e-9:  # 1e-9 s: summed steps
                 self._grad, self._grad_t = self.avoidance_gradient(q, H2), t
             u2 = self.avoid_gain * self._grad - self.null_damping * thetadot2

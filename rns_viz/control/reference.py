@@ -7,10 +7,11 @@ from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
+import pinocchio as pin
 
 from rns_viz.model import FsmsModel
 from rns_viz.profiles import QuinticSegment
-from rns_viz.rns import null_vector
+from rns_viz.rns import rk4_along
 
 
 class JointReference(Protocol):
@@ -117,7 +118,6 @@ class PathReference:
         self.ubar = ubar
         self.max_step = max_step
         self.t0 = t0
-        self._q = np.zeros(model.nv)
         self.restart()
 
     def restart(self, theta0: np.ndarray | None = None, t0: float | None = None) -> None:
@@ -131,8 +131,11 @@ class PathReference:
 
     def n(self, theta: np.ndarray) -> np.ndarray:
         """Null-space vector n(theta) (Eq. 27 generalised), kg m."""
-        self._q[self.model.m :] = theta
-        return null_vector(self.model.coupling_matrix(self._q, self.data))
+        return self.model.null_vector(theta, self.data)
+
+    def _rate(self, t: float, theta: np.ndarray) -> np.ndarray:
+        """theta_ref' = n(theta_ref) u-bar(t), Eq. (30)'s integrand."""
+        return self.n(theta) * self.ubar(t)[0]
 
     def _n_at_current(self) -> np.ndarray:
         if self._n_here is None:
@@ -144,14 +147,9 @@ class PathReference:
             self.restart()
         while self._t < t - 1e-12:
             h = min(self.max_step, t - self._t)
-            t_, th = self._t, self._theta
-            u_mid = self.ubar(t_ + 0.5 * h)[0]
-            k1 = self._n_at_current() * self.ubar(t_)[0]  # the last query's n(theta), at this point
-            k2 = self.n(th + 0.5 * h * k1) * u_mid
-            k3 = self.n(th + 0.5 * h * k2) * u_mid
-            k4 = self.n(th + h * k3) * self.ubar(t_ + h)[0]
-            self._theta = th + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            self._t, self._n_here = t_ + h, None
+            k1 = self._n_at_current() * self.ubar(self._t)[0]  # the last query's n(theta), at this point
+            self._theta = rk4_along(self._rate, self._t, self._theta, h, k1)
+            self._t, self._n_here = self._t + h, None
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         self._advance(t)
@@ -161,6 +159,26 @@ class PathReference:
         eps = 1e-6
         dn_along_n = (self.n(theta + eps * n) - self.n(theta - eps * n)) / (2 * eps)  # (Dn) n
         return theta, n * u, dn_along_n * u * u + n * du
+
+
+def along_path(
+    model: FsmsModel,
+    theta: np.ndarray,
+    dsigma: float,
+    steps: int,
+    data: pin.Data | None = None,
+    n_here: np.ndarray | None = None,
+) -> np.ndarray:
+    """theta moved by ``dsigma`` along its reactionless path, d theta/d sigma = n(theta) (Eq. 27; sigma is the
+    integral of u-bar dt, Eq. 30, 1/(kg m)), in ``steps`` equal RK4 steps. ``n_here``: n(theta), if at hand."""
+    h = dsigma / steps
+
+    def n(_sigma: float, th: np.ndarray) -> np.ndarray:
+        return model.null_vector(th, data)
+
+    for i in range(steps):
+        theta = rk4_along(n, 0.0, theta, h, n_here if i == 0 else None)
+    return theta
 
 
 def path_integral_to(

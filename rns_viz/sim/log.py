@@ -1,13 +1,16 @@
-"""Step log: one row per control step in a fixed-size ring buffer (bounded memory in long runs)."""
+"""Step log: one row per control step in a fixed-size ring buffer (bounded memory in long runs), its
+columns and their units."""
 
 from __future__ import annotations
 
-import csv
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import IO, TYPE_CHECKING, NamedTuple
 
 import numpy as np
+
+from rns_viz.csvio import write_csv
+from rns_viz.sim.ring import Ring
 
 if TYPE_CHECKING:
     from rns_viz.control.common import ControlOutput
@@ -17,7 +20,7 @@ RowCompleter = Callable[[np.ndarray], None]  # fills derived columns of a block 
 
 
 def log_columns(m: int, n: int, r: int, p: int) -> list[str]:
-    """Column names, SI units and radians (see README, "CSV columns")."""
+    """Column names, SI units and radians (documentation: CSV formats)."""
 
     def seq(prefix: str, k: int) -> list[str]:
         return [f"{prefix}_{i + 1}" for i in range(k)]
@@ -41,6 +44,51 @@ def log_columns(m: int, n: int, r: int, p: int) -> list[str]:
     ]
 
 
+class CoordinateUnits(NamedTuple):
+    """The units of one coordinate's position, velocity, force and momentum."""
+
+    position: str
+    velocity: str
+    force: str
+    momentum: str
+
+
+TRANSLATION = CoordinateUnits("m", "m/s", "N", "kg m/s")  # a prismatic joint's coordinate
+ROTATION = CoordinateUnits("rad", "rad/s", "N m", "kg m^2/s")  # a revolute joint's
+
+
+def base_units(model: FsmsModel) -> list[CoordinateUnits]:
+    """The units of each base coordinate x_b,i (a rotation where its joint is revolute)."""
+    return [ROTATION if turns else TRANSLATION for turns in model.base_rotational]
+
+
+def arm_units(model: FsmsModel) -> list[CoordinateUnits]:
+    """The units of each joint angle theta_i (a length where its joint is prismatic)."""
+    joints = model.pin_model.joints[model.m + 1 :]  # pinocchio's joint 0 is the universe
+    return [TRANSLATION if joint.shortname().startswith("JointModelP") else ROTATION for joint in joints]
+
+
+def log_units(model: FsmsModel) -> list[str]:
+    """The unit of each column of :func:`log_columns` for ``model`` (documentation: CSV formats): L_i, a row of
+    S H_bm theta', is a linear or an angular momentum as its base row is a translation or a rotation."""
+    base, arm = base_units(model), arm_units(model)
+    return [
+        "s",
+        *(u.position for u in base),
+        *(u.velocity for u in base),
+        *(u.position for u in arm),
+        *(u.velocity for u in arm),
+        *(u.force for u in arm),
+        *(u.force for u in base),
+        *["m"] * 3,
+        *(base[i].momentum for i in model.selected),
+        "kg m",  # sigma_min(W S H_bm), moment rows divided by the arm's reach (rns.singularity_distance)
+        "m/rad",  # sigma_min of the restricted Jacobian J-bar
+        *(u.position for u in arm),
+        *["m"] * len(model.task_rows),
+    ]
+
+
 class RowLayout:
     """Where each quantity of a step goes in a row of :func:`log_columns` (index arrays and slices)."""
 
@@ -48,6 +96,7 @@ class RowLayout:
         m, n = model.m, model.n
         r, p = len(model.selected), len(model.task_rows)
         self.columns = log_columns(m, n, r, p)
+        self.units = log_units(model)
         col = {name: i for i, name in enumerate(self.columns)}
         # The stacked state (x_b, theta, x_b', theta') goes to columns xb, theta, xbdot, thetadot.
         names = [f"xb_{i + 1}" for i in range(m)] + [f"theta_{i + 1}" for i in range(n)]
@@ -80,94 +129,49 @@ class RowLayout:
             row[self.ee_ref.start : self.ee_ref.start + len(out.ee_ref)] = out.ee_ref
 
 
-class StepLog:
-    """A ring buffer of rows; ``capacity`` rows are kept, the oldest dropped first.
+class StepLog(Ring):
+    """The newest ``capacity`` rows of a run, one per step, the oldest dropped first (a :class:`Ring`).
 
     ``complete``, if given, fills derived columns (the end-effector position) of newly added rows
     in place, in blocks, when the log is next read: a step only pays for what it measured.
     """
 
-    def __init__(self, columns: list[str], capacity: int, complete: RowCompleter | None = None) -> None:
+    def __init__(
+        self, columns: list[str], units: list[str], capacity: int, complete: RowCompleter | None = None
+    ) -> None:
         if capacity < 1:
             raise ValueError("log capacity must be at least one row")
+        super().__init__(capacity, len(columns))
         self.columns = columns
+        self.units = units
         self.index = {name: i for i, name in enumerate(columns)}
-        self._data = np.full((capacity, len(columns)), np.nan)
-        self._next = 0
-        self._count = 0
         self._complete = complete
-        self._incomplete = 0  # newest rows not yet passed to ``complete``
-
-    def append(self, row: np.ndarray) -> None:
-        self.next_row()[:] = row
-
-    def next_row(self) -> np.ndarray:
-        """A new row, to be filled in place by the caller (a view into the buffer, oldest row dropped)."""
-        row = self._data[self._next]
-        self._next += 1
-        if self._next == len(self._data):
-            self._next = 0
-        if self._count < len(self._data):
-            self._count += 1
-        self._incomplete += 1
-        return row
-
-    def newest(self) -> np.ndarray | None:
-        """The newest row as a view (derived columns not yet filled), or None if the log is empty."""
-        return self._data[self._next - 1] if self._count else None
+        self._completed = 0  # rows appended (Ring.appended) when the derived columns were last filled
 
     def clear(self) -> None:
-        self._next = 0
-        self._count = 0
-        self._incomplete = 0
+        super().clear()
+        self._completed = 0
 
-    def __len__(self) -> int:
-        return self._count
+    def newest(self, k: int | None = None, column: int | None = None) -> np.ndarray:
+        """As :meth:`Ring.newest`, the derived columns filled first."""
+        self._complete_rows()
+        return super().newest(k, column)
 
     def array(self, last: int | None = None) -> np.ndarray:
         """The rows in time order (a copy); ``last`` limits to the newest rows."""
-        return self._data[self._indices(last)].copy()
+        return self.newest(last)
 
     def column(self, name: str, last: int | None = None) -> np.ndarray:
-        return self._data[self._indices(last), self.index[name]]
-
-    def _indices(self, last: int | None) -> np.ndarray:
-        self._complete_rows()
-        k = self._count if last is None else min(last, self._count)
-        start = (self._next - k) % len(self._data)
-        return (start + np.arange(k)) % len(self._data)
+        return self.newest(last, self.index[name])
 
     def _complete_rows(self) -> None:
-        k = min(self._incomplete, self._count)
-        self._incomplete = 0
+        k = min(self.appended - self._completed, len(self))
+        self._completed = self.appended
         if self._complete is not None and k:
-            for block in self._newest_blocks(k):
+            for block in self.blocks(k):
                 self._complete(block)
 
-    def _newest_blocks(self, k: int) -> Iterator[np.ndarray]:
-        """The newest k rows as at most two contiguous views (the ring may wrap around)."""
-        start = self._next - k
-        if start < 0:
-            yield self._data[start:]
-            start = 0
-        if self._next > start:
-            yield self._data[start : self._next]
-
-    def write_csv(self, target: str | Path | object) -> None:
-        """Write all kept rows with a header; ``target`` is a path or a text stream."""
-        rows = self.array()
-        if isinstance(target, str | Path):
-            with Path(target).open("w", newline="") as handle:
-                self._write(handle, rows)
-        else:
-            self._write(target, rows)
-
-    def _write(self, handle: object, rows: np.ndarray) -> None:
-        write_csv_rows(handle, self.columns, rows)
-
-
-def write_csv_rows(handle: object, header: list[str], rows: np.ndarray, digits: int = 10) -> None:
-    """A header line and one line per row, ``digits`` significant digits (17 reads back bit-exact)."""
-    writer = csv.writer(handle)  # type: ignore[arg-type]
-    writer.writerow(header)
-    writer.writerows([[f"{x:.{digits}g}" for x in row] for row in rows])
+    def write_csv(self, target: str | Path | IO[str], last: int | None = None) -> int:
+        """Write the kept rows (``last``: the newest only) with units in the header (rns_viz.csvio) to a
+        path or a text stream; returns the rows written."""
+        return write_csv(target, self.columns, self.units, self.array(last))

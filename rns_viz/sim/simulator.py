@@ -69,7 +69,7 @@ class Simulator:
         self._nv = model.nv
         self._layout = RowLayout(model)
         self._ee_data = model.pin_model.createData()  # log reads never touch the laws' pinocchio data
-        self.log = StepLog(self._layout.columns, log_capacity, self._complete_rows)
+        self.log = StepLog(self._layout.columns, self._layout.units, log_capacity, self._complete_rows)
         self.reset(q0, v0)
 
     @property
@@ -169,7 +169,7 @@ class Simulator:
 
     def resize_log(self, capacity: int) -> None:
         """Keep ``capacity`` rows from now on (the current rows are dropped)."""
-        self.log = StepLog(self.log.columns, capacity, self._complete_rows)
+        self.log = StepLog(self.log.columns, self.log.units, capacity, self._complete_rows)
 
     def run(self, duration: float) -> StepLog:
         """Advance by ``duration`` seconds (rounded to whole steps) and return the log."""

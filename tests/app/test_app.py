@@ -15,6 +15,7 @@ import time
 import numpy as np
 import pytest
 
+from rns_viz.csvio import read_csv
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, serve, start_app
@@ -69,7 +70,7 @@ def test_every_control_and_scene_node_exists(name: str) -> None:
         assert set(g.gains) == {"g_b", "g_m", "G_p", "G_d", "k_p", "k_d"}
         assert all("(" in s.label for s in g.gains.values())  # units in every gain label
         assert g.speed.options == ("1/8×", "1/4×", "1/2×", "1×", "2×")
-        assert set(g.presets_trep.options) | set(g.presets_3r.options) == PAPER_PRESETS
+        assert set(g.presets["trep"].options) | set(g.presets["planar3r"].options) == PAPER_PRESETS
         assert g.path_folder.visible == (name == "trep") and g.target_folder.visible == (name == "planar3r")
         for node in (FsmsScene.BASE, FsmsScene.FORCE, FsmsScene.TARGET, TARGET_HANDLE):
             assert app.server.scene.get_handle_by_name(node) is not None, node
@@ -230,7 +231,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False)
     try:
         s = app.session
-        app.gui.presets_trep.value = "fig10-on"
+        app.gui.presets["trep"].value = "fig10-on"
         queued(app, "LoadPreset")
         s.advance(0.0)
         assert s.wait_background()
@@ -243,7 +244,7 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
         s.advance(1.0)  # the preset's kick comes at 0.5 s
         assert peak_xb(s, 1.0) > 1e-3
         app.gui.preset_paused.value = False  # this one starts at once
-        app.gui.presets_3r.value = "fig3"  # a 3R preset switches the model
+        app.gui.presets["planar3r"].value = "fig3"  # a 3R preset switches the model
         queued(app, "LoadPreset")
         s.advance(0.0)
         assert s.wait_background()
@@ -261,10 +262,10 @@ def test_presets_load_their_law_gains_and_kicks() -> None:
 def test_log_download_has_the_step_log_columns(trep_app: RnsApp, client: ProtocolClient) -> None:
     s = trep_app.session
     s.advance(0.5)
-    text = s.log_csv().decode()
-    header, *rows = text.strip().splitlines()
-    assert header.split(",") == s.state.runs.sim.log.columns
-    assert len(rows) == 500 and all(math.isfinite(float(x)) for x in rows[-1].split(",")[:5])
+    table = read_csv(s.log_csv())
+    log = s.state.runs.sim.log
+    assert list(table.columns) == log.columns and list(table.units) == log.units
+    assert len(table.rows) == 500 and all(math.isfinite(x) for x in table.rows[-1, :5])
     client.click(uuid(trep_app.gui.download))
     wait_until(lambda: client.types["FileTransferStartDownload"] >= 1, 10.0, "the CSV download to start")
 

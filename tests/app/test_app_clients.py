@@ -24,11 +24,9 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.server.app import TARGET_HANDLE, start_app
-from tests.support.browser import live_group, wait_until
+from tests.support.browser import wait_until
 from tests.support.protocol_client import ProtocolClient, gui_uuid
 from tests.support.repo import REPO
-
-pytestmark = live_group  # servers running in real time: one at a time (tests/support/browser.py)
 
 DURATION_S = 30.0  # wall seconds of churn when the real-time factor is asserted (the issue asks for 30 s)
 BEHAVIOUR_S = 10.0  # wall seconds of churn for the behaviour alone: some 60 connects and deaths of clients

@@ -6,6 +6,7 @@ fault, and the app keeps the model it runs. A headless server driven by protocol
 
 from __future__ import annotations
 
+import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -13,8 +14,10 @@ import numpy as np
 import pytest
 
 from rns_viz.cli import main
+from rns_viz.live.runs.laws import LAW_LABELS
+from rns_viz.params import ASSETS_DIR
 from rns_viz.viz.panels.base_panel import BasePanel
-from rns_viz.viz.panels.model_menu import MODEL_LABELS
+from rns_viz.viz.panels.model_menu import label_of
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.app_helpers import user_model
 from tests.support.browser import wait_for_clients, wait_until
@@ -53,12 +56,12 @@ def choose(app: RnsApp, client: ProtocolClient, label: str) -> None:
 def test_the_dropdown_switches_among_bundled_models_and_a_file_and_every_client_stays_served(app_with_file) -> None:  # type: ignore[no-untyped-def]
     app, path, operator, watcher, _ = app_with_file
     labels = app.gui.model.options
-    assert MODEL_LABELS["boom7"] in labels and "file: my_arm.toml" in labels
+    assert label_of("boom7") in labels and "file: my_arm.toml" in labels
     for label, key, m in (
-        (MODEL_LABELS["boom7"], "boom7", 6),
+        (label_of("boom7"), "boom7", 6),
         ("file: my_arm.toml", str(path.resolve()), 1),
-        (MODEL_LABELS["trep"], "trep", 1),
-        (MODEL_LABELS["boom7"], "boom7", 6),
+        (label_of("trep"), "trep", 1),
+        (label_of("boom7"), "boom7", 6),
     ):
         choose(app, operator, label)
         snap = app.session.snapshot()
@@ -88,7 +91,7 @@ def test_a_bad_model_file_is_refused_naming_the_element_and_the_app_keeps_its_mo
     assert client == app.lock.operator  # told to the client who asked
     snap = app.session.snapshot()
     assert snap.settings.model == "trep" and snap.t > 0.5 and np.allclose(snap.q[1:], q_before[1:], atol=0.1)
-    wait_until(lambda: app.gui.model.value == MODEL_LABELS["trep"], 10.0, "the dropdown to show TREP again")
+    wait_until(lambda: app.gui.model.value == label_of("trep"), 10.0, "the dropdown to show TREP again")
     before = watcher.messages
     app.session.advance(0.2)  # the simulation runs on and the watcher is served
     wait_until(lambda: watcher.messages > before, 10.0, "the watcher to get updates")
@@ -101,3 +104,63 @@ def test_serve_refuses_a_bad_model_file_naming_the_element(tmp_path: Path, capsy
     assert main(["serve", "--model", str(path), "--port", "0"]) == 2
     err = capsys.readouterr().err
     assert "[base] joints" in err and "base_q" in err and "my_arm.urdf" in err
+
+
+MY_APP = """
+[app]
+label = "My TREP copy"
+short_label = "Mine"
+law = "acceleration"
+kick_peak_N = 1.5
+kick_range_N = 8.0
+kick_duration_s = 0.05
+target_speed_m_per_s = 0.3
+presets = ["fig10-on", "fig11-slow"]
+lessons = ["trep-spring"]
+
+[app.gains.acceleration]
+g_b_per_s = 7.0
+g_m_per_s = 3.0
+
+[app.scene]
+exaggeration = 25.0
+base = { kind = "double-beam", spacing_m = 0.12 }
+camera_position_m = [1.0, 2.0, 3.0]
+"""
+
+
+def test_a_model_file_with_its_own_app_table_is_offered_with_its_label_presets_lessons_and_defaults(
+    tmp_path: Path,
+) -> None:
+    """A new model is a URDF and a parameter file: a copy of TREP's under another name, with an [app] table of
+    its own, served with no Python written: its label in the dropdown, its presets in their own row, its
+    lesson in the chooser, and the app starting with its law, gains, kick, speed and drawing."""
+    shutil.copy(ASSETS_DIR / "trep.urdf", tmp_path / "my_trep.urdf")
+    text = (ASSETS_DIR / "trep.toml").read_text()
+    text = text[: text.index("\n[app]")].replace('"trep.urdf"', '"my_trep.urdf"').replace('name = "trep"', "")
+    path = tmp_path / "my_trep.toml"
+    path.write_text(text + MY_APP)
+    app = start_app(str(path), port=0, realtime=False, verbose=False)
+    try:
+        key = str(path.resolve())
+        g = app.gui
+        assert g.model.value == "My TREP copy" and "My TREP copy" in g.model.options
+        assert label_of("trep") in g.model.options  # the bundled models stay offered
+        assert g.presets[key].label == "My TREP copy" and g.presets[key].options == ("fig10-on", "fig11-slow")
+        assert g.presets[key].visible and g.presets["trep"].visible  # a heading of its own: both rows shown
+        assert app.lessons.choices["Mine 1. The base is a spring"] == (key, 1)
+        snap = app.session.snapshot()
+        st = snap.settings
+        assert (st.model, st.law, st.gains.g_b, st.gains.g_m, st.target_speed) == (key, "acceleration", 7.0, 3.0, 0.3)
+        wait_until(lambda: app.model_name == key, 20.0, "the scene of the file's model")
+        assert (g.kick_peak.value, g.kick_peak.max, g.exaggeration.value) == (1.5, 8.0, 25.0)
+        assert not g.auto_exaggeration.value  # a number in the file: a fixed factor
+        assert g.law.value == LAW_LABELS["acceleration"] and g.gains["g_b"].value == 7.0
+        style = app.renderer.scene.style
+        assert style.camera_position == (1.0, 2.0, 3.0) and style.base.spacing == 0.12  # type: ignore[union-attr]
+        assert "0.05 s" in g.kick_peak.hint  # the pulse this model's kick sends
+        app.session.kick(1.5)
+        app.session.advance(0.2)
+        assert np.max(np.abs(app.session.plot_arrays()["xb_1"])) > 0.0
+    finally:
+        app.stop()

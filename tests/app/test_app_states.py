@@ -1,9 +1,10 @@
 """Every state transition leaves one consistent app: a stateful test (hypothesis' RuleBasedStateMachine)
 drives a stepped app through random sequences of model switches (every bundled model and a model file),
-presets, lessons, replays, gain-map clicks, laws, selections, kicks, resets and browser tabs that join,
-leave, reload and take control, and after each step checks tests/support/app_invariants.py: no exception in any
-thread or worker, everything published and drawn belongs to the model, gains and run in force, every tab's
-scene is the server's, and the operator lock and the unwatched-restart rule behave.
+presets, lessons, replays, gain-map clicks, the map's show/hide toggle, laws, selections, kicks, resets and
+browser tabs that join, leave, reload and take control, and after each step checks
+tests/support/app_invariants.py: no exception in any thread or worker, everything published and drawn belongs
+to the model, gains and run in force, every tab's scene is the server's, and the operator lock and the
+unwatched-restart rule behave.
 
 The default run is bounded (derandomised, a few examples of 20 steps); ``python -m pytest -m slow_state
 -n 0 tests/test_app_states.py`` runs a longer one.
@@ -25,7 +26,7 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.commands import LIVE_LAWS
 from rns_viz.scenarios import LIVE_SCENARIOS
 from rns_viz.viz.clients.connections import BROWSER_KEY
-from rns_viz.viz.panels.lesson_panel import CHOICES
+from rns_viz.viz.panels.lesson_panel import lesson_choices
 from rns_viz.viz.scene.scene_nodes import node_names
 from rns_viz.viz.server.app import IDLE_RESTART_S, RnsApp, start_app
 from tests.support.app_helpers import Faults, user_model
@@ -164,6 +165,10 @@ class AppStates(RuleBasedStateMachine):
             self.s.set_gains(g_b=round(50.0 * u, 1), g_m=round(50.0 * v, 1))
         self.settle()
 
+    def show_gain_map(self, on: bool) -> None:
+        """Tick or untick *Gain map* in *Show in the scene*: the map is drawn only while it is ticked."""
+        self.app.view.show("gain_map", on)
+
     def start_replay(self, seconds: float) -> None:
         self.s.start_replay(seconds)  # with nothing recorded yet: refused with a notice
         self.settle()
@@ -243,7 +248,7 @@ class AppStates(RuleBasedStateMachine):
     @rule(
         change=st.one_of(
             st.tuples(st.just("load_preset"), st.sampled_from(sorted(LIVE_SCENARIOS)), st.booleans()),
-            st.tuples(st.just("start_lesson"), st.sampled_from(sorted(CHOICES.values()))),
+            st.tuples(st.just("start_lesson"), st.sampled_from(sorted(lesson_choices().values()))),
             st.tuples(st.just("selection"), st.sampled_from(SELECTIONS)),
             st.sampled_from((("reset",), ("stop_lesson",))),
         )
@@ -258,6 +263,7 @@ class AppStates(RuleBasedStateMachine):
             st.tuples(st.just("suppression"), st.booleans()),
             st.tuples(st.just("law"), st.sampled_from(LIVE_LAWS)),
             st.tuples(st.just("click_gain_map"), st.floats(0.05, 0.95), st.floats(0.05, 0.95)),
+            st.tuples(st.just("show_gain_map"), st.booleans()),
         )
     )
     def operate(self, act: tuple[Any, ...]) -> None:
@@ -374,8 +380,10 @@ REPORTED = {
         ("kick", 1.0),
         ("run", 5.0),
         ("run", 5.0),
+        ("show_gain_map", True),
         ("click_gain_map", 0.3, 0.7),
         ("switch_model", "boom7"),
+        ("show_gain_map", False),
     ],
     "a lesson, then another model": [("start_lesson", ("trep", 6)), ("switch_model", "planar3r")],
     "a reload of the operator's page": [("join", False), ("join", False), ("run", 2.0), ("reload", 0)],

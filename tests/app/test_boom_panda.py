@@ -9,7 +9,7 @@ import viser
 
 from rns_viz import robots
 from rns_viz.model import FsmsModel
-from rns_viz.viz.panels.model_menu import MODEL_LABELS, label_of
+from rns_viz.viz.panels.model_menu import label_of
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.server.app import start_app
 from tests.support.browser import wait_for_clients, wait_until
@@ -34,7 +34,7 @@ def test_choosing_it_without_the_extra_keeps_the_app_and_tells_the_operator(pand
         wait_until(refusal, 10.0, "the operator's page to be told the install command")
         app.session.advance(0.05)  # refused before anything was queued: the session runs on as it was
         assert app.session.snapshot().settings.model == "trep" and app.render_thread.is_alive()
-        wait_until(lambda: app.gui.model.value == MODEL_LABELS["trep"], 10.0, "the dropdown to show TREP again")
+        wait_until(lambda: app.gui.model.value == label_of("trep"), 10.0, "the dropdown to show TREP again")
     finally:
         operator.close()
         app.stop()

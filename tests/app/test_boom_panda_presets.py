@@ -26,16 +26,16 @@ def test_the_app_serving_boom_panda_shows_its_presets_and_keeps_the_panda() -> N
     try:
         wait_for_clients(app, 1, "the operator")
         app.session.advance(0.05)
-        wait_until(lambda: app.gui.presets_panda.visible, 20.0, "the Panda's presets to be shown")
-        assert not app.gui.presets_boom7.visible
-        operator.click(gui_uuid(app.gui.presets_panda), "boom-panda-track")
+        wait_until(lambda: app.gui.presets["boom-panda"].visible, 20.0, "the Panda's presets to be shown")
+        assert not app.gui.presets["boom7"].visible
+        operator.click(gui_uuid(app.gui.presets["boom-panda"]), "boom-panda-track")
         wait_until(lambda: "LoadPreset" in app.session.pending_commands(), 10.0, "the preset to be queued")
         app.session.advance(0.0)
         assert app.session.wait_background(120.0)
         snap = app.session.snapshot()
         assert snap.settings.model.startswith("boom-panda") and app.session.state.runs.sim.model.n == 7
         assert app.session.state.runs.sim.model.arm_joint_names[0] == "panda_joint1"
-        assert app.gui.presets_panda.visible and not app.gui.presets_boom7.visible
+        assert app.gui.presets["boom-panda"].visible and not app.gui.presets["boom7"].visible
     finally:
         operator.close()
         app.stop()

@@ -19,7 +19,7 @@ from tests.support.app_helpers import realtime_app
 from tests.support.browser import live_group, wait_for_clients, wait_until
 from tests.support.protocol_client import ProtocolClient
 
-pytestmark = live_group  # servers running in real time: one at a time (tests/support/browser.py)
+pytestmark = live_group  # the app meets slow and frozen clients: one such test at a time (tests/support/browser.py)
 
 
 # ---------------------------------------------------------------- the app, protocol-level clients

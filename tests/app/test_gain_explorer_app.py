@@ -31,6 +31,7 @@ def drawn(app: RnsApp) -> bool:
 
 def ready_app(model: str) -> Iterator[RnsApp]:
     app = start_app(model, port=0, realtime=False, verbose=False)
+    app.view.show("gain_map")  # out of the scene by default
     assert app.session.wait_background()
 
     def step() -> bool:
@@ -229,7 +230,10 @@ def test_map_image_marks_unstable_cells_and_clicks_map_to_cells(app: RnsApp) -> 
 
 
 def test_panel_states_the_views_and_the_loci_split_base_and_arm(app: RnsApp) -> None:
-    ex, view = explorer(app), app.session.gain_view()
+    s = app.session
+    s.advance(0.01)  # an earlier test may have clicked a cell: the loci of its gains come from the helper
+    assert s.wait_background()
+    ex, view = explorer(app), s.gain_view()
     assert view.g_m_meaning in app.gui.gains["g_m"].hint
     assert "predicted" in ex.predicted.content and "1/s" in ex.predicted.content
     assert "1/s" in ex.authority.content
@@ -269,6 +273,7 @@ def test_after_a_kick_the_panel_sets_the_measured_decay_beside_the_prediction(ap
 
 def test_after_a_model_switch_the_new_models_map_is_drawn() -> None:
     app = start_app("trep", port=0, realtime=False, verbose=False)
+    app.view.show("gain_map")  # ticked: it stays ticked across the switch (render.KEPT_ACROSS_MODELS)
     try:
         assert app.session.wait_background()
         app.session.switch_model("planar3r", None)

@@ -28,7 +28,7 @@ def test_bad_quaternions_from_a_client_are_told_and_the_simulation_runs_on() -> 
     try:
         wait_for_clients(app, 1, "the websocket client")
         before = np.array(s.snapshot().target, dtype=float)
-        goal_R = s.state.operator.rr.goal_R.copy()  # type: ignore[union-attr]
+        goal_R = s.state.operator.tracker.goal_R.copy()  # type: ignore[union-attr]
         lifted = before + app.controls.target_lift + np.array([0.02, 0.0, 0.0])
         for bad in ((np.nan, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0)):
             told = ws.types["NotificationShowMessage"]
@@ -45,7 +45,7 @@ def test_bad_quaternions_from_a_client_are_told_and_the_simulation_runs_on() -> 
         snap = s.snapshot()
         assert not snap.paused and snap.diverged is None and snap.t == pytest.approx(t0 + 0.5)
         assert np.allclose(snap.target, before)  # the target in force is untouched
-        assert np.allclose(s.state.operator.rr.goal_R, goal_R)  # type: ignore[union-attr]
+        assert np.allclose(s.state.operator.tracker.goal_R, goal_R)  # type: ignore[union-attr]
     finally:
         ws.close()
         apps.close()

@@ -24,11 +24,14 @@ def test_app_draws_the_replayed_step_and_plots(trep_app: RnsApp) -> None:
     t = rec.t[400]
     s.seek_replay(float(t))
     s.advance(0.0)
-    exaggeration = float(app.good(app.gui.exaggeration))
-    drawn = app.renderer._drawn(rec.q(400), exaggeration)
-    wait_until(lambda: np.array_equal(app.scene.q, drawn), 5.0, "the scene to show the replayed step")
+    drawn = app.renderer._drawn  # q as drawn at a factor (the auto factor follows the replayed motion)
+    wait_until(
+        lambda: np.array_equal(app.scene.q, drawn(rec.q(400), app.scene.exaggeration)),
+        5.0,
+        "the scene to show the replayed step",
+    )
     ghost = app.renderer.teach.ghost
-    wait_until(lambda: np.array_equal(ghost.q, app.renderer._drawn(rec.q_shadow(400), exaggeration)), 5.0, "ghost")
+    wait_until(lambda: np.array_equal(ghost.q, drawn(rec.q_shadow(400), ghost.exaggeration)), 5.0, "ghost")
     wait_until(lambda: not app.replay.timeline.disabled, 5.0, "the timeline")
     wait_until(lambda: app.replay.timeline.value == round(t, 2), 5.0, "the timeline at the playhead")
     wait_until(lambda: float(app.gui.plots.xb.data[0][-1]) <= t + 1e-9, 5.0, "the plots up to the playhead")

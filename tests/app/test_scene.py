@@ -48,7 +48,12 @@ def test_scene_builds_with_its_nodes(
     for node in (FsmsScene.BASE, FsmsScene.PATHS, FsmsScene.TRAIL, FsmsScene.FORCE, FsmsScene.GRID, base_node):
         assert server.scene.get_handle_by_name(node) is not None, node
     assert len(scene.robot.meshes) >= model.n  # every arm link has a visual
-    assert np.allclose(server.initial_camera.look_at, scene.style.camera_look_at)
+    # the initial camera looks at the framed box's centre along the style's view direction
+    cam = server.initial_camera
+    assert np.allclose(cam.look_at, scene.framed.mean(axis=0))
+    view = np.subtract(cam.position, cam.look_at)
+    style_view = np.subtract(scene.style.camera_position, scene.style.camera_look_at)
+    assert np.allclose(view / np.linalg.norm(view), style_view / np.linalg.norm(style_view))
 
 
 def test_update_bends_the_beam_by_exaggerated_deflection(trep_scene: FsmsScene, trep: FsmsModel) -> None:

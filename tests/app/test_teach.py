@@ -42,6 +42,7 @@ def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp, trep:
 
 def test_drawn_n_and_force_are_the_models(trep_app: RnsApp, trep: FsmsModel) -> None:
     app, s = trep_app, trep_app.session
+    app.view.show("null_vector")  # off in TREP's first look (defaults.py)
     s.play_fast()
     s.advance(0.4)
     snap = s.snapshot()

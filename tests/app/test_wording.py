@@ -1,8 +1,8 @@
 """Words on screen that must be true: controls named by the lessons exist under those names and are not
 disabled when a lesson names them, and one quantity has one notation everywhere it is shown.
 
-Lessons name a control in *italics*, exactly as the panel labels it (a folder may be named without its
-parenthesis: *Live plots* for 'Live plots (last 10 s)')."""
+Lessons name a control in *italics*, exactly as the panel labels it (a folder or tab may be named without
+its parenthesis: *Live plots* for the tab 'Live plots (last 10 s)')."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ import viser
 import rns_viz
 from rns_viz.live.published.snapshot import LessonStatus
 from rns_viz.live.teaching import lessons, lessons_boom
-from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
 from rns_viz.viz.panels import lesson_panel
 from rns_viz.viz.server.app import RnsApp, start_app
 
@@ -40,13 +40,13 @@ def app() -> Iterator[RnsApp]:
 
 
 def controls(app: RnsApp) -> dict[str, list[Any]]:
-    """Every name a person can find in the panel -> the controls of that name: labels of buttons, boxes,
-    dropdowns and folders (also without a trailing parenthesis), and the options of button groups."""
+    """Every name a person can find in the panels -> the controls of that name: labels of buttons, boxes,
+    dropdowns, folders and tabs (also without a trailing parenthesis), and the options of button groups."""
     gui = app.server.gui
     names: dict[str, list[Any]] = {}
     handles = [*gui._gui_input_handle_from_uuid.values(), *gui._container_handle_from_uuid.values()]  # (viser's)
     for handle in handles:
-        label = getattr(handle, "label", None)
+        label = getattr(handle, "label", None) or getattr(handle, "_label", None)  # a tab's is private (viser's)
         for name in (label, re.sub(r" \([^()]*\)$", "", label or "")):
             if name:
                 names.setdefault(name, []).append(handle)
@@ -72,7 +72,8 @@ def progress_texts() -> list[str]:
 
 
 def lesson_texts() -> list[str]:
-    texts = [part for ls in LESSONS.values() for lesson in ls for part in (lesson.text, lesson.task)]
+    lessons = [lesson for model in models_with_lessons() for lesson in lessons_for(model)]
+    texts = [part for lesson in lessons for part in (lesson.text, lesson.task)]
     return [*texts, *progress_texts(), lesson_panel.NO_LESSON, lesson_panel.LAST_DONE]
 
 
@@ -90,7 +91,8 @@ def test_no_lesson_asks_for_a_disabled_control(app: RnsApp) -> None:
     snap = app.session.snapshot()
     states = [None] + [
         LessonStatus(model, k, len(ls), lesson.title, lesson.equation, lesson.text, lesson.task, done, "…")
-        for model, ls in LESSONS.items()
+        for model in models_with_lessons()
+        for ls in (lessons_for(model),)
         for k, lesson in enumerate(ls, start=1)
         for done in (False, True)
     ]
@@ -101,7 +103,7 @@ def test_no_lesson_asks_for_a_disabled_control(app: RnsApp) -> None:
             for handle in names.get(name, []):
                 if isinstance(handle, viser.GuiButtonHandle):
                     assert not handle.disabled, f"{status}: the text asks for {name!r}, which is disabled"
-    last = LESSONS["trep"][-1]
+    last = lessons_for("trep")[-1]
     done = LessonStatus("trep", 6, 6, last.title, last.equation, last.text, last.task, True, "")
     app.lessons.refresh(replace(snap, lesson=done))
     assert app.lessons.next.disabled and "*Next*" not in app.lessons.text.content
@@ -114,7 +116,7 @@ def shown_strings() -> Iterator[tuple[str, str]]:
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Constant) and isinstance(node.value, str):
                 yield f"{path.name}:{node.lineno}", node.value
-    for path in (ROOT.parent / "README.md", *sorted((ROOT.parent / "docs").glob("*.md"))):
+    for path in (ROOT.parent / "README.md", *sorted((ROOT.parent / "docs").rglob("*.md"))):
         yield path.name, path.read_text()
 
 

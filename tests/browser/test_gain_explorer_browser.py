@@ -5,6 +5,7 @@ artifacts/gain_map_<model>.png."""
 from __future__ import annotations
 
 import io
+import math
 import re
 import time
 from collections.abc import Iterator
@@ -27,11 +28,13 @@ from rns_viz.viz.scene.gain_scene import (
     map_rates,
     not_predictable,
 )
+from rns_viz.viz.scene.view_toggles import TOGGLES
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
+    open_folder,
     screenshot,
     settle_for_picture,
     wait_for_frames,
@@ -39,6 +42,7 @@ from tests.support.browser import (
     wait_until,
 )
 
+TOGGLE_LABELS = {name: label for name, label, _, _ in TOGGLES}
 PROJECT_JS = """(points) => {
     const m = window.__viserMutable;
     const node = m?.nodeRefFromName?.["/gain_map"];
@@ -62,6 +66,23 @@ def screen_point(page: Page, local: tuple[float, float, float]) -> tuple[float, 
     return None if pixels is None else tuple(pixels[0])
 
 
+SCENE_RECT_JS = """() => {
+    const canvas = [...document.querySelectorAll("canvas")].sort(
+        (a, b) => b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight
+    )[0];
+    const r = canvas.getBoundingClientRect();
+    return [r.left, r.top, r.right, r.bottom];
+}"""  # page pixels of the scene's canvas (between the docked panels)
+
+
+def map_on_screen(page: Page, scene: GainScene) -> bool:
+    """Every corner of the map inside the scene's canvas, as the page's camera sees it now."""
+    half = 0.5 * scene.size
+    corners = [screen_point(page, (x, y, 0.0)) for x in (-half, half) for y in (-half, half)]
+    left, top, right, bottom = page.evaluate(SCENE_RECT_JS)
+    return all(c is not None and left <= c[0] <= right and top <= c[1] <= bottom for c in corners)
+
+
 def test_gain_map_in_chromium(app: RnsApp) -> None:
     ex = app.renderer.explorer
     with browser_page(app.server, width=1500, height=900) as page:
@@ -70,29 +91,35 @@ def test_gain_map_in_chromium(app: RnsApp) -> None:
         dismiss_notifications(page)
         scene = ex.scene
         assert scene is not None and scene.gain_map is not None
+        assert not scene.frame.visible  # out of the scene until its box is ticked
+        # The user ticks the map; every camera then frames the robot with the map beside it.
+        open_folder(page, "Show in the scene")
+        page.get_by_role("checkbox", name=TOGGLE_LABELS["gain_map"]).click()
+        wait_until(lambda: app.view.on("gain_map") and scene.frame.visible, 10.0, "the gain map shown")
+        wait_until(lambda: map_on_screen(page, scene), 10.0, "the whole map in the page's view")
         gm = scene.gain_map
-        # A real click on a stable cell applies it (when the page lets us find the camera).
+        # A real click on a stable cell applies it.
         i, j = 18, 30
         assert gm.stable[i, j]
         u, v = axis_fraction(gm.g_b, gm.g_b[i]), axis_fraction(gm.g_m, gm.g_m[j])
         pixel = screen_point(page, ((u - 0.5) * scene.size, (v - 0.5) * scene.size, 0.0))
-        if pixel is not None:
-            want = (float(gm.g_b[i]), float(gm.g_m[j]))
+        assert pixel is not None, "the page's camera or the map was not found"
+        want = (float(gm.g_b[i]), float(gm.g_m[j]))
 
-            def applied() -> bool:
-                return (app.session.snapshot().settings.gains.g_b, app.session.snapshot().settings.gains.g_m) == want
+        def applied() -> bool:
+            return (app.session.snapshot().settings.gains.g_b, app.session.snapshot().settings.gains.g_m) == want
 
-            # A toast arriving late (a busy machine) can sit over the map's corner and take the click:
-            # close toasts and click again, as a user would; the gains must then be the cell's.
-            for _ in range(3):
-                dismiss_notifications(page)
-                page.mouse.click(*pixel)
-                deadline = time.monotonic() + 10.0
-                while not applied() and time.monotonic() < deadline:
-                    time.sleep(0.05)
-                if applied():
-                    break
-            assert applied(), f"a click in the browser did not apply {want}"
+        # A toast arriving late (a busy machine) can sit over the map's corner and take the click:
+        # close toasts and click again, as a user would; the gains must then be the cell's.
+        for _ in range(3):
+            dismiss_notifications(page)
+            page.mouse.click(*pixel)
+            deadline = time.monotonic() + 10.0
+            while not applied() and time.monotonic() < deadline:
+                time.sleep(0.05)
+            if applied():
+                break
+        assert applied(), f"a click in the browser did not apply {want}"
         wait_until(lambda: app.plot_updates > 5, 15.0, "live plot updates")
         page.mouse.move(5, 5)
         page.get_by_text("Gain explorer", exact=True).scroll_into_view_if_needed()
@@ -132,6 +159,7 @@ PICTURE_WAIT_S = 20.0  # s: for the page to draw a new map's picture
 @pytest.fixture(params=["trep", "planar3r", "boom7"], name="map_app")
 def each_model_map_app(request: pytest.FixtureRequest) -> Iterator[RnsApp]:
     app = start_app(request.param, port=0, verbose=False)
+    app.view.show("gain_map")  # out of the scene by default
     yield app
     app.stop()
 
@@ -150,12 +178,25 @@ def expected_colours(rates: np.ndarray, scale: tuple[float, float]) -> np.ndarra
     return want
 
 
+FACING_FILL = 0.9  # the faced map spans this fraction of the scene's narrower side: its edge cells stay clear
+# of what borders the scene (the docked plots panel's resize grip reaches a few pixels into it)
+
+
 def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
-    """Put the page's camera in front of the map, looking at its centre (the map fills the view)."""
+    """Put the page's camera in front of the map, looking at its centre, at the distance where the map spans
+    FACING_FILL of the scene's width or height, whichever is narrower (the page's own field of view)."""
     client = next(iter(app.server.get_clients().values()))
-    wait_until(lambda: client.camera.update_timestamp > 0, 10.0, "the page's camera")
-    client.camera.position = scene.centre + 1.0 * scene.size * scene.rotation[:, 2]
-    client.camera.look_at = scene.centre
+    cam = client.camera
+    wait_until(lambda: cam.update_timestamp > 0 and cam.image_width > 0, 10.0, "the page's camera")
+    # the scene's own canvas as laid out now, between the docked panels (the camera's size may predate them)
+    width, height = page.evaluate(
+        "() => { const c = [...document.querySelectorAll('canvas')].sort((a, b) =>"
+        " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
+        " return [c.clientWidth, c.clientHeight]; }"
+    )
+    half_view = math.tan(0.5 * cam.fov) * min(width / height, 1.0)  # per unit of distance
+    cam.position = scene.centre + 0.5 * scene.size / (FACING_FILL * half_view) * scene.rotation[:, 2]
+    cam.look_at = scene.centre
     wait_for_frames(page, 10)
 
 
@@ -212,6 +253,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     page.mouse.move(*(centre if hovered else (5.0, 5.0)))
     deadline = time.monotonic() + PICTURE_WAIT_S
     while True:
+        dismiss_notifications(page)  # a toast arriving late (a busy machine) sits over part of the map
         wait_for_frames(page, 10)
         gm, scale = scene.gain_map, legend_scale(scene.legend.text)  # (the map of the pose now)
         cells = screen_cells(page, scene, gm)  # (where the page's camera is now)
@@ -226,6 +268,8 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
             break
     for mark in marks:
         mark.visible = True  # type: ignore[attr-defined]
+    if not (read.sum() > 0.2 * read.size and agree[read].mean() >= AGREEING_CELLS):
+        screenshot(page, f"gain_map_disagrees_{app.model_name}_{quantity}")
     bad = tuple(np.argwhere(read & ~agree)[0]) if not agree[read].all() else None
     assert read.sum() > 0.2 * read.size, f"{quantity}: only {read.sum()} cells drawn in legend colours to read"
     assert agree[read].mean() >= AGREEING_CELLS, (

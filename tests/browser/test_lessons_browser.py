@@ -22,7 +22,7 @@ from PIL import Image
 from playwright.sync_api import Page
 
 from rns_viz.defaults import defaults_for
-from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.live.teaching.lessons import lessons_for
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.ghost import Ghost
 from rns_viz.viz.server.app import RnsApp, start_app
@@ -30,6 +30,7 @@ from tests.support.browser import (
     ARTIFACTS,
     browser_page,
     dismiss_notifications,
+    open_folder,
     settle_for_picture,
     wait_for_nodes,
     wait_until,
@@ -95,7 +96,7 @@ def walk(model: str, numbers: list[int]) -> None:
         s = app.session
         with browser_page(app.server, width=1400, height=900, timeout=60.0) as page:
             wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE}, timeout=60.0)
-            count = len(LESSONS[model])
+            count = len(lessons_for(model))
             for number in numbers:
                 s.start_lesson(model, number)
                 wait_until(
@@ -118,7 +119,7 @@ def walk(model: str, numbers: list[int]) -> None:
             if model == "trep":  # the last lesson replayed: the simulation waits, the timeline runs
                 s.start_replay(10.0)
                 wait_until(lambda: s.snapshot().replay is not None, 10.0, "the replay")
-                page.get_by_text("Record and replay", exact=True).click()
+                open_folder(page, "Record and replay")
                 wait_until(lambda: not app.replay.timeline.disabled, 10.0, "the timeline")
                 page.get_by_role("button", name="Back to live").scroll_into_view_if_needed()
                 time.sleep(2.0)
@@ -139,4 +140,4 @@ def test_a_lesson_started_from_the_session_shows_in_the_page(model: str, number:
 @pytest.mark.docs
 @pytest.mark.parametrize("model", ["trep", "planar3r", "boom7"])
 def test_walk_every_lesson_with_screenshots(model: str) -> None:
-    walk(model, list(range(1, len(LESSONS[model]) + 1)))
+    walk(model, list(range(1, len(lessons_for(model)) + 1)))

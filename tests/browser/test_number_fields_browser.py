@@ -11,7 +11,7 @@ from playwright.sync_api import Locator, Page
 
 from rns_viz.viz.panels.number_field import shown
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.support.browser import browser_page, dismiss_notifications, wait_until
+from tests.support.browser import browser_page, dismiss_notifications, open_folder, wait_until
 
 FOLDERS = ("Control law and gains", "Model and view", "Record and replay")  # closed at first
 
@@ -49,7 +49,7 @@ def test_typed_gains_are_applied_exactly_or_refused_with_a_message(app: RnsApp) 
     with browser_page(app.server, width=1400, height=900) as page:
         dismiss_notifications(page)
         for folder in FOLDERS:
-            page.get_by_text(folder, exact=True).click()
+            open_folder(page, folder)
         # No slider shows viser's own number box; under each track is a text box showing its value.
         thumbs = page.get_by_role("slider")
         assert thumbs.count() >= 8  # TREP, law (30): kick, path, ū speed, g_b, g_m, drawn ×, replay N s, replay ×
@@ -60,12 +60,12 @@ def test_typed_gains_are_applied_exactly_or_refused_with_a_message(app: RnsApp) 
             assert not root.locator("xpath=following-sibling::*[contains(@class, 'NumberInput')]").is_visible()
             typed = root.locator("xpath=following::input[not(contains(@class, 'NumberInput'))][1]")
             assert "TextInput" in (typed.get_attribute("class") or "") and typed.is_visible()
-        box = box_of(page, "g_b (1/s)")
+        box = box_of(page, "Base damping g_b (1/s)")
         box.scroll_into_view_if_needed()
         for text, message in (
             ("1e9", "gain g_b must be from 0 to 1e+06, got 1e+09"),
             ("NaN", "gain g_b must be a finite number, got nan"),
-            ("abc", "g_b (1/s): 'abc' is not a number"),
+            ("abc", "Base damping g_b (1/s): 'abc' is not a number"),
         ):
             old = gains().g_b
             dismiss_notifications(page)
@@ -81,6 +81,6 @@ def test_typed_gains_are_applied_exactly_or_refused_with_a_message(app: RnsApp) 
             wait_until(lambda v=value: box.input_value() == shown(v), 10.0, f"the box to show {value}")
             assert told[before:] == [], told[before:]
         # A value typed into g_m far beyond its slider's range is the number typed.
-        type_keys(page, box_of(page, "g_m (1/s)"), "2.5e3")
+        type_keys(page, box_of(page, "Joint hold g_m (1/s)"), "2.5e3")
         wait_until(lambda: gains().g_m == 2500.0, 10.0, "g_m = 2500 from '2.5e3'")
         assert app.gui.gains["g_m"].max >= 2500.0

@@ -16,8 +16,9 @@ from rns_viz.live.loop.session import Session
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.server.app import RnsApp
 from tests.support.app_helpers import realtime_app
-from tests.support.browser import browser_page, wait_for_nodes, wait_until
+from tests.support.browser import browser_page, live_group, wait_for_nodes, wait_until
 
+pytestmark = live_group  # the app meets slow and frozen pages: one such test at a time (tests/support/browser.py)
 NOTICE = re.compile(r"Display slowed to \d+ Hz to keep up")
 THROTTLE = 16  # times slower: the page's CPU (Chromium's emulation)
 SLOW_S = 120.0  # s: what a throttled software-rendered page may take for one step

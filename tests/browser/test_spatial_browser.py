@@ -84,7 +84,7 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
     with browser_page(app.server, width=1400, height=900) as page:
         wait_for_nodes(page, {FsmsScene.BASE, TARGET_HANDLE, "/boom/tube"}, timeout=60.0)
         dismiss_notifications(page)
-        s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (README)
+        s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (docs/models.md)
         s.set_selection((True, True, True, False, False, False))  # what ticking off rx, ry, rz sends
         wait_until(lambda: s.snapshot().settings.model == "boom7#S=111000", 20.0, "the forces-only selection")
         s.track_orientation(False)  # a position handle: a pose handle's arrows turn with the hand's orientation
@@ -129,7 +129,7 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
         try:
             wait_until(lambda: gap() < 3e-3, 60.0, "the arm to arrive")
         except AssertionError as e:
-            rr = s.state.operator.rr  # type: ignore[union-attr]
+            rr = s.state.operator.tracker  # type: ignore[union-attr]
             raise AssertionError(f"{e}: {gap() * 1e3:.1f} mm from the target, blocked at a fold: {rr.blocked}") from e
         log = s.state.runs.sim.log  # one read of its rows: the loop appends to it meanwhile
         L = log.array(3000)[:, [log.index[f"L_{i}"] for i in (1, 2, 3)]]
@@ -166,7 +166,7 @@ def test_boom7_r1_pose_target_turns_the_hand_with_the_rotation_rings(boom_app: R
         label = page.get_by_text("track orientation", exact=True)
         wait_until(lambda: label.count() > 0, 20.0, "the box on the page")
         model = s.state.model
-        rr = s.state.operator.rr  # type: ignore[union-attr]
+        rr = s.state.operator.tracker  # type: ignore[union-attr]
         goal = rns_walk(model, s.snapshot().q[6:], seed=5, steps=250)
         x_goal, R_goal = rr.ee(goal), rr.ee_rotation(goal)
         q = pin.Quaternion(R_goal)

@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from playwright.sync_api import sync_playwright
 
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.ghost import Ghost
@@ -27,15 +26,14 @@ from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     ARTIFACTS,
-    CHROMIUM,
     browser_page,
-    chromium_flags,
     dismiss_notifications,
     local_position,
-    new_test_page,
+    open_folder,
     screenshot,
     settle_for_picture,
     start_drawing,
+    url_page,
     wait_for_frames,
     wait_for_nodes,
     wait_until,
@@ -60,7 +58,7 @@ def test_lesson1_with_the_ghost_in_chromium(app: RnsApp) -> None:
         settle_for_picture(page, 20)
         assert screenshot(page, "lesson1_start").stat().st_size > 10_000
         # The student ticks the ghost under "Show in the scene", then scrolls back to the lesson.
-        page.get_by_text("Show in the scene", exact=True).click()
+        open_folder(page, "Show in the scene")
         page.get_by_role("checkbox", name="Ghost: the shadow run").click()
         wait_until(lambda: app.view.on("ghost"), 10.0, "the ghost to be ticked")
         page.get_by_text("Lesson 1 of 6", exact=False).scroll_into_view_if_needed()
@@ -123,23 +121,18 @@ def test_exported_recording_plays_in_viser_player(tmp_path: Path) -> None:
     httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
     threading.Thread(target=httpd.serve_forever, daemon=True).start()
     try:
-        with sync_playwright() as pw:
-            browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(), headless=True)
-            try:
-                page = new_test_page(browser, 1280, 800)
-                page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}", timeout=60_000)
-                wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, FsmsScene.ROBOT}, timeout=60.0)
-                seen = set()
-                deadline = time.monotonic() + 20.0
-                while len(seen) < 3 and time.monotonic() < deadline:  # the base at several places as it plays
-                    pos = local_position(page, FsmsScene.BASE)
-                    if pos is not None:
-                        seen.add(round(pos[0], 5))
-                    time.sleep(0.1)
-                assert len(seen) >= 3, f"the base did not move in the player: {seen}"
-                settle_for_picture(page, 20)
-                assert screenshot(page, "playback_trep").stat().st_size > 10_000
-            finally:
-                browser.close()
+        url = f"http://127.0.0.1:{httpd.server_address[1]}/{PLAYER_URL}"
+        with url_page(url, timeout=60.0) as page:
+            wait_for_nodes(page, {FsmsScene.BASE, Ghost.BASE, FsmsScene.ROBOT}, timeout=60.0)
+            seen = set()
+            deadline = time.monotonic() + 20.0
+            while len(seen) < 3 and time.monotonic() < deadline:  # the base at several places as it plays
+                pos = local_position(page, FsmsScene.BASE)
+                if pos is not None:
+                    seen.add(round(pos[0], 5))
+                time.sleep(0.1)
+            assert len(seen) >= 3, f"the base did not move in the player: {seen}"
+            settle_for_picture(page, 20)
+            assert screenshot(page, "playback_trep").stat().st_size > 10_000
     finally:
         httpd.shutdown()

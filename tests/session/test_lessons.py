@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rns_viz.live.loop.session import Session
-from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.live.teaching.lessons import lessons_for
 from tests.support.app_helpers import run_lesson
 
 
@@ -115,8 +115,8 @@ def test_planar3r_lessons(
 
 
 def test_every_lesson_is_checked_here() -> None:
-    assert {n for n, _, _ in TREP_CASES} == set(range(1, len(LESSONS["trep"]) + 1))
-    assert {n for n, _, _ in PLANAR_CASES} == set(range(1, len(LESSONS["planar3r"]) + 1))
+    assert {n for n, _, _ in TREP_CASES} == set(range(1, len(lessons_for("trep")) + 1))
+    assert {n for n, _, _ in PLANAR_CASES} == set(range(1, len(lessons_for("planar3r")) + 1))
 
 
 def test_bad_lesson_numbers_are_refused() -> None:

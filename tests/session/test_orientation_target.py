@@ -34,7 +34,7 @@ def test_live_pose_target_the_arm_follows_and_bad_quaternions_are_refused(live: 
     model = s.state.model
     theta0 = s.snapshot().q[6:]
     goal = rns_walk(model, theta0, seed=4, steps=200)
-    rr = s.state.operator.rr  # type: ignore[union-attr]
+    rr = s.state.operator.tracker  # type: ignore[union-attr]
     x_goal, R_goal = rr.ee(goal), rr.ee_rotation(goal)
     wxyz = pin.Quaternion(R_goal)
     for bad in ((np.nan, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0), (1.0, 0.0, 0.0)):

@@ -23,7 +23,7 @@ def _reference_coupling(s: Session) -> float:
 
 def test_live_reach_set_inside_tracked_outside_held_and_said(boom7_session: Session) -> None:
     s = boom7_session
-    s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (see README)
+    s.set_suppression(False)  # (15)'s suppression of the forces alone pumps the free torsion (docs/models.md)
     s.set_selection(FORCES)
     s.advance(0.01)
     assert s.wait_background(60.0)
@@ -71,7 +71,7 @@ def test_r4_tracks_a_target_and_r5_tracks_on_its_reachable_surface(boom7_session
     s.advance(0.01)
     start = np.asarray(s.snapshot().target)
     model, op = s.state.model, s.state.operator
-    q = model.q(op.rr.theta)  # type: ignore[union-attr]
+    q = model.q(op.tracker.theta)  # type: ignore[union-attr]
     P = rns_projector(model.coupling_matrix(q))
     data = model.pin_model.createData()
     J = pin.computeFrameJacobian(model.pin_model, data, q, model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)

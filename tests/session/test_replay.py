@@ -15,11 +15,11 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
+from rns_viz.csvio import read_csv
 from rns_viz.live.loop import commands as c
 from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.loop.session import Session
 from rns_viz.live.outputs.recorder import MAX_RECORD_S
-from rns_viz.live.published.recording import read_csv
 from tests.support.browser import wait_until
 
 KICKS = {"trep": 0.8, "planar3r": 5.0}
@@ -98,9 +98,9 @@ def test_csv_reads_back_the_recording_with_units() -> None:
         for cell in ("t (s)", "xb_1 (m)", "theta_1 (rad)", "thetadot_1 (rad/s)", "tau_1 (N m)", "L_1 (kg m/s)"):
             assert cell in header
         assert "shadow_xb_1 (m)" in header and "reaction (N)" in header
-        names, rows = read_csv(data)
-        assert tuple(names) == rec.columns
-        assert np.array_equal(rows, rec.table, equal_nan=True)  # 17 digits: every float back exactly
+        table = read_csv(data)
+        assert table.columns == rec.columns and table.units == rec.units
+        assert np.array_equal(table.rows, rec.table, equal_nan=True)  # 17 digits: every float back exactly
     finally:
         s.stop()
 

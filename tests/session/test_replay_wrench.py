@@ -10,9 +10,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from rns_viz.csvio import read_csv
 from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.loop.session import Session
-from rns_viz.live.published.recording import read_csv
 from rns_viz.live.published.snapshot import ReplayView
 from tests.support.app_helpers import kicked_boom7
 
@@ -52,9 +52,9 @@ def test_csv_carries_the_wrench_with_units(boom7_run: tuple[Session, dict[float,
     for i in range(1, 4):
         assert f"reaction_{i} (N)" in header and f"reaction_{i + 3} (N m)" in header
     assert "xb_4 (rad)" in header and "xb_1 (m)" in header
-    names, rows = read_csv(rec.csv())
-    assert tuple(names) == rec.columns
-    assert np.array_equal(rows, rec.table, equal_nan=True)
+    table = read_csv(rec.csv())
+    assert table.columns == rec.columns
+    assert np.array_equal(table.rows, rec.table, equal_nan=True)
 
 
 def _replaying(live: object, rec: object, t: float) -> object:

@@ -85,9 +85,11 @@ def queued(app: RnsApp, kind: str, count: int = 1) -> None:
 
 
 def user_model(folder: Path) -> Path:
-    """A user's own model: the planar 3R's URDF and parameters under another name, in another folder."""
+    """A user's own model: the planar 3R's URDF and parameters under another name, in another folder (without the
+    3R's [app] table: the app's generic defaults)."""
     shutil.copy(ASSETS_DIR / "planar3r.urdf", folder / "my_arm.urdf")
     text = (ASSETS_DIR / "planar3r.toml").read_text()
+    text = text[: text.index("\n[app]")]
     text = text.replace('name = "planar3r"', 'name = "my_arm"').replace('"planar3r.urdf"', '"my_arm.urdf"')
     path = folder / "my_arm.toml"
     path.write_text(

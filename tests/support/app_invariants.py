@@ -20,7 +20,7 @@ import numpy as np
 from rns_viz.params import BUNDLED_MODELS, model_source
 from rns_viz.viz.panels.gain_panel import authority_text, predicted_text
 from rns_viz.viz.panels.lesson_panel import chooser_entry, lesson_markdown
-from rns_viz.viz.panels.model_menu import MODEL_LABELS, label_of
+from rns_viz.viz.panels.model_menu import label_of
 from rns_viz.viz.panels.model_words import kick_hint, target_text
 from rns_viz.viz.scene.scene_nodes import node_names
 from rns_viz.viz.server.app import RnsApp
@@ -106,18 +106,21 @@ def drawn_violations(app: RnsApp, references: dict[str, set[str]]) -> list[str]:
     drawn_map = ex.scene.gain_map if ex.scene is not None else None
     if drawn_map is not None and (drawn_map.loop.model_name, drawn_map.loop.law) != (st.model, st.law):
         out.append(f"the drawn gain map is {drawn_map.loop.model_name}/{drawn_map.loop.law}'s")
+    ticked = app.view.on("gain_map")  # the map is drawn only while its box in *Show in the scene* is ticked
     if (
         (view.map is None) != (drawn_map is None)
         or ex.scene is None
-        or ex.scene.frame.visible != (view.map is not None)
+        or ex.scene.frame.visible != (view.map is not None and ticked)
     ):
-        out.append("the gain map drawn (or hidden) is not the view's")
+        out.append(f"the gain map drawn (or hidden) is not the view's (its box {'ticked' if ticked else 'unticked'})")
+    elif not ticked and (ex.scene.authority.visible or ex.scene.authority_lines.visible):
+        out.append("the authority overlay is drawn while the gain map's toggle is not ticked")
     on_path = r.model.n - len(r.model.selected) == 1
     texts = {
         "predicted": (ex.predicted.content, predicted_text(view)),
         "authority": (ex.authority.content, authority_text(view, on_path)),
         "lesson": (app.lessons.text.content, lesson_markdown(snap.lesson)),
-        "lesson chooser": (app.lessons.chooser.value, chooser_entry(snap.lesson, st.model)),
+        "lesson chooser": (app.lessons.chooser.value, chooser_entry(snap.lesson, st.model, app.lessons.choices)),
         "target": (g.target_text.content, target_text(r.model)),
         "kick hint": (g.kick_peak.hint, kick_hint(r.model)),
     }
@@ -141,7 +144,7 @@ def _words_violations(app: RnsApp, source: str, on_path: bool) -> list[str]:
     shown += [g.target_text.content] if not on_path else []
     shown += [slider.hint or "" for slider in g.gains.values() if slider.visible]
     shown += [f"{box.label} {box.hint or ''}" for box in app.view.boxes.values() if box.visible]
-    own = MODEL_LABELS.get(source, "") + " " + label_of(source)
+    own = label_of(source)
     others = [w for m, w in MODEL_WORDS.items() if m in BUNDLED_MODELS and w not in own and m != source]
     out = [f"the panel says {w!r} on {source}: {t!r}" for t in shown for w in others if w in t]
     if len(app.renderer.model.task_rows) == 3 and any("x and y only" in t for t in shown):

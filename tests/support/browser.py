@@ -1,7 +1,7 @@
 """Real-browser helpers: Debian chromium driven by Playwright against a local viser server.
 
 Recipe (docs/testing-notes.md): ``/usr/bin/chromium`` (apt), never ``playwright install``; headless with
-software rendering (SwiftShader), a fresh user-data-dir per browser. Scene nodes are read from
+software rendering (SwiftShader), one browser per test process and a fresh context per page. Scene nodes are read from
 the client's ``window.__viserMutable.nodeRefFromName`` (viser/client/src/App.tsx exposes it).
 """
 
@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page, Playwright, sync_playwright
 
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
 from tests.support.repo import REPO
@@ -95,12 +95,14 @@ def chromium_available() -> bool:
 requires_chromium = pytest.mark.skipif(
     not chromium_available() and os.environ.get("RNS_VIZ_REQUIRE_BROWSER") != "1", reason=SKIP_REASON
 )
-# The tests run in two pytest-xdist workers (pyproject's addopts). Everything that races the wall clock (a
-# browser, a server running in real time) goes to one worker, one test at a time, so two of them never
-# share the two cores; the headless tests fill the other worker.
+# The tests run in pytest-xdist workers (pyproject's addopts), each taking the next test when it is free.
+# A test whose subject is how the app meets the wall clock (a page too slow for its stream, a frozen tab:
+# rns_viz.viz.server.page_pacing) joins the "live" group: those run in one worker, one at a time, so two of
+# them never compete for the cores. Browser tests and real-time apps otherwise spread over the workers: each
+# waits for what must happen with a generous timeout, never for a rate, and a page at rest draws nothing.
 live_group = pytest.mark.xdist_group("live")
 # What every real-browser test gets, applied by tests/conftest.py to the tests in tests/browser/.
-browser_marks = [pytest.mark.browser, requires_chromium, live_group]
+browser_marks = [pytest.mark.browser, requires_chromium]
 
 
 def wait_until(condition: Callable[[], object], timeout: float, what: str, poll: float = 0.05) -> None:
@@ -128,24 +130,65 @@ def local_server() -> Iterator[viser.ViserServer]:
         server.stop()
 
 
+class SharedChromium:
+    """One Playwright driver and one Chromium per kind (drawing its scene or not: the flag is the browser's)
+    for the whole test process, launched on first use and closed when the test session ends
+    (tests/conftest.py). Every page still gets a browser context of its own (its own storage and cache, as a
+    fresh profile gave), so tests stay apart; what they share is the start of a driver and a browser (about
+    a second each time, and that much CPU taken from the other worker)."""
+
+    def __init__(self) -> None:
+        self._playwright: Playwright | None = None
+        self._browsers: dict[bool, Browser] = {}
+
+    def browser(self, draw: bool) -> Browser:
+        """The running Chromium of this kind, launched (again, if it went away) when needed."""
+        draw = draws(draw)
+        if self._playwright is None:
+            self._playwright = sync_playwright().start()
+        browser = self._browsers.get(draw)
+        if browser is None or not browser.is_connected():
+            browser = self._playwright.chromium.launch(
+                executable_path=str(CHROMIUM), args=chromium_flags(draw), headless=True
+            )
+            self._browsers[draw] = browser
+        return browser
+
+    def close(self) -> None:
+        for browser in self._browsers.values():
+            if browser.is_connected():
+                browser.close()
+        self._browsers.clear()
+        if self._playwright is not None:
+            self._playwright.stop()
+            self._playwright = None
+
+
+CHROMIUMS = SharedChromium()
+
+
+@contextmanager
+def url_page(
+    url: str, width: int = 1280, height: int = 800, timeout: float = 30.0, draw: bool = False
+) -> Iterator[Page]:
+    """A page of the shared Chromium showing ``url``, in a browser context of its own that is closed
+    afterwards; its 3-D scene is drawn only if ``draw`` (or pictures are wanted, :func:`pictures_wanted`)."""
+    page = new_test_page(CHROMIUMS.browser(draw), width, height, draw)
+    try:
+        page.goto(url, timeout=timeout * 1000)
+        yield page
+    finally:
+        page.context.close()
+
+
 @contextmanager
 def browser_page(
     server: viser.ViserServer, width: int = 1280, height: int = 800, timeout: float = 30.0, draw: bool = False
 ) -> Iterator[Page]:
-    """A Playwright page showing ``server``, yielded once the client has connected; its 3-D scene is
-    drawn only if ``draw`` (or pictures are wanted, :func:`pictures_wanted`).
-
-    ``chromium.launch`` gives every browser a fresh temporary profile (user-data-dir) of its own.
-    """
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=chromium_flags(draw), headless=True)
-        try:
-            page = new_test_page(browser, width, height, draw)
-            page.goto(f"http://127.0.0.1:{server.get_port()}/", timeout=timeout * 1000)
-            wait_until(lambda: len(server.get_clients()) > 0, timeout, "the browser to connect to viser")
-            yield page
-        finally:
-            browser.close()
+    """A Playwright page showing ``server``, yielded once the client has connected (:func:`url_page`)."""
+    with url_page(f"http://127.0.0.1:{server.get_port()}/", width, height, timeout, draw) as page:
+        wait_until(lambda: len(server.get_clients()) > 0, timeout, "the browser to connect to viser")
+        yield page
 
 
 def scene_node_names(page: Page) -> set[str]:
@@ -172,6 +215,12 @@ def dismiss_notifications(page: Page) -> None:
     on each close button in one call (a software-rendered page answers each Playwright action only after
     its next frame, so one locator click per toast took ~1 s)."""
     page.evaluate("() => document.querySelectorAll('.mantine-Notification-closeButton').forEach((b) => b.click())")
+
+
+def open_folder(page: Page, label: str) -> None:
+    """Click the title of the panel folder ``label``, not a text that names it (a lesson or a hint names a
+    folder in *italics*: an ``em`` of the same words)."""
+    page.get_by_text(label, exact=True).and_(page.locator(":not(em, strong, code)")).click()
 
 
 def wait_for_nodes(page: Page, names: set[str], timeout: float = 30.0) -> None:

@@ -156,6 +156,10 @@ class ProtocolClient:
         """A slider, checkbox, text field or dropdown changed."""
         self.gui_update(uuid, value=value)
 
+    def command(self, uuid: str) -> None:
+        """A keyboard command (its hotkey pressed, or picked in the command palette)."""
+        self._send(_messages.CommandTriggerMessage(uuid))
+
     def click(self, uuid: str, value: Any = True) -> None:
         """A button click (a button group sends the clicked option as the value)."""
         self.gui_update(uuid, value=value)
@@ -166,21 +170,24 @@ class ProtocolClient:
         position: tuple[float, float, float],
         phase: str = "update",
         wxyz: tuple[float, ...] = _IDENTITY,
+        owner: str = "",
     ) -> None:
         """A transform-controls drag event on scene node ``name`` (position in the parent frame);
-        phase "start" and "end" also send the drag start/end markers around it."""
+        phase "start" and "end" also send the drag start/end markers around it. ``owner``: the scope of the
+        node dragged, as the page echoes it ("" the shared scene, a client id's string that client's own)."""
         if phase == "start":
-            self.drag_phase(name, "start")
-        self._send(_messages.TransformControlsUpdateMessage(name, tuple(wxyz), tuple(float(x) for x in position)))  # type: ignore[arg-type]
+            self.drag_phase(name, "start", owner)
+        position_ = tuple(float(x) for x in position)
+        self._send(_messages.TransformControlsUpdateMessage(name, tuple(wxyz), position_, owner=owner))  # type: ignore[arg-type]
         if phase == "end":
-            self.drag_phase(name, "end")
+            self.drag_phase(name, "end", owner)
 
-    def drag_phase(self, name: str, phase: str) -> None:
+    def drag_phase(self, name: str, phase: str, owner: str = "") -> None:
         """Drag start/end markers (viser's TransformControlsDragStart/EndMessage) if this viser has them."""
         cls = {"start": "TransformControlsDragStartMessage", "end": "TransformControlsDragEndMessage"}[phase]
         message_type = getattr(_messages, cls, None)
         if message_type is not None:
-            self._send(message_type(name))
+            self._send(message_type(name, owner=owner))
 
     def scene_click(
         self,

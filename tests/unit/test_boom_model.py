@@ -1,11 +1,11 @@
-"""boom7's boom against a finite-element model of the same tube (tests/oracles/tube_fe.py).
+"""boom7's boom against a finite-element model of the same tube (tests/support/oracles/tube_fe.py).
 
 The six tip coordinates carry the tube by Guyan's static condensation: the tip stiffness K_b
 (boom7.toml) and the mass of the static deflection shapes (boom7.urdf, link boom_tube). A
 200-element model of the tube with the same plate and the same locked arm at the tip (their 6 x 6
 inertia from pinocchio, on the URDF without the tube's link) is the reference for the locked-arm
 modes: the model's first four are within 1.5 % of it; its fifth and sixth, and the tube's own higher
-modes, are what six tip coordinates cannot carry (boom7.toml and the README say so, with these numbers).
+modes, are what six tip coordinates cannot carry (boom7.toml and docs/models.md say so, with these numbers).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from tests.support.oracles.tube_fe import Tube, condensed, modes
 
 TUBE = Tube(E=68.9e9, G=26.0e9, rho=2700.0, length=4.0, outer_diameter=0.100, wall=0.002)  # boom7.toml's
 ELEMENTS = 200
-DOCUMENTED_HZ = (1.620, 1.626, 13.16, 15.31, 30.5, 157.0)  # boom7.toml and README, this model's locked-arm modes
+DOCUMENTED_HZ = (1.620, 1.626, 13.16, 15.31, 30.5, 157.0)  # boom7.toml and docs/models.md: the locked-arm modes
 
 
 def without_tube(model: FsmsModel) -> pin.Model:

@@ -20,11 +20,11 @@ from rns_viz import robots
 from rns_viz.control import AccelerationLaw, FixedReference
 from rns_viz.control.hold import JointServo
 from rns_viz.model import FsmsModel
-from rns_viz.params import ASSETS_DIR, ModelFileError, missing_extra
+from rns_viz.params import ASSETS_DIR, ModelFileError, missing_extra, param_file_for
 from rns_viz.rns import restricted_jacobian, rns_projector
 from rns_viz.scenarios import BOOM7_GAINS, BOOM7_KICK, FORCES_ONLY
 from rns_viz.sim import ForcePulse, Simulator
-from rns_viz.viz.panels.model_menu import MODEL_LABELS, ModelMenu, label_of
+from rns_viz.viz.panels.model_menu import ModelMenu, label_of
 
 PANDA = "example-robot-data/panda"
 installed = pytest.mark.skipif(
@@ -144,7 +144,7 @@ def test_without_the_extra_the_model_is_refused_with_the_install_command(panda_n
     assert "boom-panda.toml" in str(caught.value) and "[model] arm" in str(caught.value)
     assert missing_extra("boom-panda") == "panda" and missing_extra("boom7") is None
     label = label_of("boom-panda")
-    assert label.startswith(MODEL_LABELS["boom-panda"]) and "rns-viz[panda]" in label
+    assert label.startswith(param_file_for("boom-panda").app.label) and "rns-viz[panda]" in label
     assert ModelMenu().key_of(label) == "boom-panda"
 
 

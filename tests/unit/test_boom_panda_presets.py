@@ -16,6 +16,7 @@ import pytest
 from rns_viz import robots
 from rns_viz.control import JointQuintic
 from rns_viz.control.hold import JointServo
+from rns_viz.csvio import read_csv
 from rns_viz.scenarios import (
     BOOM7_GAINS,
     BOOM7_MOVE_S,
@@ -24,10 +25,10 @@ from rns_viz.scenarios import (
     SPATIAL_SCENARIOS,
     boom7_path_reference,
     boom7_track_end,
+    presets_for,
     run_scenario,
 )
 from rns_viz.sim import Simulator
-from rns_viz.viz.panels.control_panel import BOOM7_PRESETS, PANDA_PRESETS
 from tests.support.logs import columns
 
 pytestmark = pytest.mark.skipif(
@@ -51,7 +52,8 @@ def test_the_panda_has_boom7s_five_experiments_under_its_own_name() -> None:
         s.removeprefix("boom7-") for s in SPATIAL_SCENARIOS
     ]
     assert all(s.model == "boom-panda" for s in PANDA_SCENARIOS.values())
-    assert tuple(PANDA_SCENARIOS) == PANDA_PRESETS and not set(PANDA_PRESETS) & set(BOOM7_PRESETS)
+    panda, boom7 = presets_for("boom-panda"), presets_for("boom7")
+    assert tuple(PANDA_SCENARIOS) == panda and not set(panda) & set(boom7)
 
 
 @pytest.mark.parametrize("name", list(PANDA_SCENARIOS))
@@ -115,7 +117,6 @@ def test_the_cli_runs_a_panda_preset_headless(tmp_path: Path) -> None:
     )
     assert result.returncode == 0, result.stderr
     steps = int(result.stdout.removeprefix("boom-panda-path: ").split(" steps")[0])
-    lines = out.read_text().splitlines()
-    assert steps >= 500 and len(lines) == steps + 1  # 1 ms steps over 0.5 s, and a header
-    header = lines[0].split(",")
-    assert "xb_6" in header and "theta_7" in header
+    table = read_csv(out)
+    assert steps >= 500 and len(table.rows) == steps  # 1 ms steps over 0.5 s
+    assert "xb_6" in table.columns and "theta_7" in table.columns

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 import subprocess
 import sys
@@ -11,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rns_viz.csvio import read_csv
 from tests.support.oracles.closed_forms import trep_ee
 from tests.support.repo import ASSETS
 
@@ -35,14 +35,12 @@ def test_paths_csv(tmp_path: Path) -> None:
     out = tmp_path / "paths.csv"
     result = run("paths", "--model", "trep", "--count", "6", "--csv", str(out))
     assert result.returncode == 0, result.stderr
-    with out.open() as handle:
-        rows = list(csv.DictReader(handle))
-    assert list(rows[0]) == ["path", "s", "theta_1", "theta_2", "ee_x", "ee_y", "ee_z"]
-    assert {int(r["path"]) for r in rows} == set(range(6))
-    for r in rows[::7]:
-        theta = np.array([float(r["theta_1"]), float(r["theta_2"])])
-        ee = np.array([float(r["ee_x"]), float(r["ee_y"]), float(r["ee_z"])])
-        np.testing.assert_allclose(ee, trep_ee(theta), atol=1e-12)
+    table = read_csv(out)
+    assert table.columns == ("path", "s", "theta_1", "theta_2", "ee_x", "ee_y", "ee_z")
+    assert table.units == ("index", "rad", "rad", "rad", "m", "m", "m")
+    assert set(table.column("path")) == set(range(6))
+    for r in table.rows[::7]:
+        np.testing.assert_allclose(r[4:7], trep_ee(r[2:4]), atol=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -97,4 +95,36 @@ def test_malformed_parameter_file(tmp_path: Path) -> None:
     bad.write_text(params.replace("stiffness = [[77.9218]]", 'stiffness = [["stiff"]]'))
     result = run("info", "--model", str(bad))
     assert result.returncode == 2 and "Traceback" not in result.stderr
-    assert "bad.toml: [base] stiffness must be numbers" in result.stderr
+    assert "bad.toml: [base] stiffness[0][0]: expected a number, got a string" in result.stderr
+
+
+def test_model_dir_offers_model_files_and_names_the_others(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``serve --model-dir``: a student's folder may hold anything; a model file joins the dropdown, a file that
+    is not one is named on stderr and left out (the app still starts)."""
+    from rns_viz.cli import _models_in
+    from tests.support.app_helpers import user_model
+
+    good = user_model(tmp_path)
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "not-a-model"\n')
+    (tmp_path / "notes.txt").write_text("not a parameter file")
+    assert _models_in(tmp_path) == [str(good.resolve())]
+    assert "pyproject.toml" in capsys.readouterr().err
+    assert _models_in(tmp_path / "absent") == []  # no folder yet: nothing offered, no error
+
+
+def test_jupyter_entry_point_serves_on_loopback_with_the_students_model_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What jupyter-server-proxy is given: a command on loopback at the proxy's port with the model folder,
+    an existing SVG icon for the launcher, and the root redirected to the page (tests/browser runs it)."""
+    from rns_viz.cli import build_parser
+    from rns_viz.jupyter import setup_rns_viz
+
+    monkeypatch.setenv("RNS_VIZ_MODEL_DIR", str(tmp_path))
+    spec = setup_rns_viz()
+    command = spec["command"](port=43210)
+    args = build_parser().parse_args(command[3:])  # after "python -m rns_viz.cli"
+    assert (args.host, args.port, args.model_dir) == ("127.0.0.1", 43210, str(tmp_path))
+    icon = Path(spec["launcher_entry"]["icon_path"])
+    assert icon.suffix == ".svg" and "<svg" in icon.read_text()
+    assert spec["launcher_entry"]["title"] == "rns_viz" and spec["timeout"] >= 30.0

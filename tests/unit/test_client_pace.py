@@ -7,6 +7,7 @@ import asyncio
 import itertools
 import math
 from collections.abc import AsyncGenerator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import pytest
@@ -121,7 +122,9 @@ def test_the_gate_is_asked_before_each_window_but_not_inside_a_split_update() ->
         async for window in _paced(windows(), 7, wait_s, max_window=128):
             events.append(str(len(window)))
 
-    asyncio.run(take())
+    # a thread of its own: a test process that drove Chromium (Playwright's sync API) has a loop in this one
+    with ThreadPoolExecutor(1) as pool:
+        pool.submit(asyncio.run, take()).result()
     assert events == ["gate", "3", "gate", "128", "128", "5", "gate", "4", "gate"]  # (the last: before the end)
 
 

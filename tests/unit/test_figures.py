@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from rns_viz.csvio import read_csv
 from rns_viz.figures import FIGURES, draw_all
 
 
@@ -46,11 +47,26 @@ def test_cli_run_writes_the_documented_columns(tmp_path: Path) -> None:
         timeout=120,
     )
     assert result.returncode == 0, result.stderr
-    header = out.read_text().splitlines()[0].split(",")
+    table = read_csv(out)
+    header, data = list(table.columns), table.rows
     required = ["t", "xb_1", "xbdot_1", "theta_1", "theta_2", "thetadot_1", "thetadot_2", "tau_1", "tau_2"]
     required += ["fext_1", "ee_x", "ee_y", "ee_z"]
     assert header[: len(required)] == required
-    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert table.units[: len(required)] == (
+        "s",
+        "m",
+        "m/s",
+        "rad",
+        "rad",
+        "rad/s",
+        "rad/s",
+        "N m",
+        "N m",
+        "N",
+        "m",
+        "m",
+        "m",
+    )
     assert data.shape == (1000, len(header))
     np.testing.assert_allclose(np.diff(data[:, 0]), 1e-3, atol=1e-9)
     peak_force = data[:, header.index("fext_1")].max()

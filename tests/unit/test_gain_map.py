@@ -25,6 +25,7 @@ from rns_viz.analysis import (
 )
 from rns_viz.control import AccelerationLaw, FixedReference, Gains, TorqueLaw, VelocityLaw
 from rns_viz.control.common import CouplingEvaluator
+from rns_viz.csvio import read_csv
 from rns_viz.model import FsmsModel
 from rns_viz.paths import trace_paths
 from rns_viz.scenarios import FIG12_GAINS, FIG12_KICK_AT_S, run_scenario
@@ -262,9 +263,10 @@ def test_cli_gains_writes_the_map(tmp_path: Path, trep: FsmsModel) -> None:
     out = tmp_path / "map.csv"
     result = _cli("gains", "--model", "trep", "--law", "30", "--csv", str(out))
     assert result.returncode == 0, result.stderr
-    header = out.read_text().splitlines()[0].split(",")
-    assert header[:6] == ["g_b", "g_m", "base_decay_rate_per_s", "arm_decay_rate_per_s", "base_damping_ratio", "stable"]
-    data = np.genfromtxt(out, delimiter=",", skip_header=1)
+    table = read_csv(out)
+    header, data = table.columns, table.rows
+    assert header[:6] == ("g_b", "g_m", "base_decay_rate", "arm_decay_rate", "base_damping_ratio", "stable")
+    assert table.units[:6] == ("1/s", "1/s", "1/s", "1/s", "1", "1 = stable")
     assert data.shape == (3600, len(header))
     stable = data[:, 5].astype(bool)
     assert stable.any() and not stable.all()

@@ -1,12 +1,12 @@
-"""The helper process answers a request it has seen from its reply cache (rns_viz.live.jobs.helper): the same
-bytes as computing it again, one computation for two requests, failures computed each time, and the
-least recently used replies leave first once the byte budget is spent."""
+"""A request answered before is answered from the reply cache of the app's process
+(rns_viz.live.jobs.helper), without the helper process: one computation for two requests, each caller
+its own copy of the same result, failures computed each time, and the least recently used replies leave
+first once the byte budget is spent."""
 
 from __future__ import annotations
 
-import io
 import pickle
-from typing import Any
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -15,59 +15,49 @@ from rns_viz.live.jobs import helper as jobs
 from rns_viz.model import FsmsModel
 
 
-def framed(*requests: tuple[str, tuple[Any, ...]]) -> io.BytesIO:
-    out = io.BytesIO()
-    for request in requests:
-        jobs._write(out, request)
-    out.seek(0)
-    return out
+@pytest.fixture
+def computed(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[str]]:
+    """The names of the jobs sent to the helper process, an empty cache to start with."""
+    sent: list[str] = []
+    run = jobs._Helper._run
+
+    def counting(helper: jobs._Helper, name: str, request: bytes) -> bytes:
+        sent.append(name)
+        return run(helper, name, request)
+
+    monkeypatch.setattr(jobs._Helper, "_run", counting)
+    monkeypatch.setattr(jobs._helper, "cache", jobs.ReplyCache())
+    yield sent
 
 
-def replies(stream: io.BytesIO) -> list[bytes]:
-    stream.seek(0)
-    found = []
-    while True:
-        try:
-            found.append(jobs._read_bytes(stream))
-        except EOFError:
-            return found
-
-
-def test_a_repeated_request_is_computed_once_and_answered_with_the_same_bytes(
-    monkeypatch: pytest.MonkeyPatch, trep: FsmsModel
+def test_a_repeated_request_is_computed_once_and_each_caller_gets_its_own_copy(
+    computed: list[str], trep: FsmsModel
 ) -> None:
     seed = trep.spec.default_configuration
-    computed: list[str] = []
-
-    def counting(name: str, real: Any) -> Any:
-        def job(*args: Any) -> Any:
-            computed.append(name)
-            return real(*args)
-
-        return job
-
-    monkeypatch.setattr(jobs, "JOBS", {name: counting(name, f) for name, f in jobs.JOBS.items()})
-    out = io.BytesIO()
-    jobs.serve(framed(("path_table", ("trep", seed)), ("path_table", ("trep", seed))), out)
-    first, second = replies(out)
+    first = jobs.call("path_table", "trep", seed)
+    second = jobs.call("path_table", "trep", seed)
     assert computed == ["path_table"]
-    assert first == second
-    ok, table = pickle.loads(second)
+    assert pickle.dumps(first) == pickle.dumps(second)  # the same reply ...
+    assert second is not first and second.theta is not first.theta  # ... unpickled for each caller
     fresh = jobs.path_table("trep", seed)
-    assert ok and np.array_equal(table.theta, fresh.theta) and np.array_equal(table.sigma, fresh.sigma)
+    assert np.array_equal(second.theta, fresh.theta) and np.array_equal(second.sigma, fresh.sigma)
 
     # Another seed is another request: computed, not served from the first.
-    out = io.BytesIO()
-    jobs.serve(framed(("path_table", ("trep", seed)), ("path_table", ("trep", seed + 0.01))), out)
-    assert computed == ["path_table"] * 3
+    jobs.call("path_table", "trep", seed + 0.01)
+    assert computed == ["path_table"] * 2
 
 
-def test_a_failed_request_is_computed_again() -> None:
-    out = io.BytesIO()
-    jobs.serve(framed(*[("path_table", ("no-such-model", np.zeros(3)))] * 2), out)
-    answers = [pickle.loads(r) for r in replies(out)]
-    assert [ok for ok, _ in answers] == [False, False]
-    assert all("no-such-model" in text for _, text in answers)
+def test_a_failed_request_is_computed_again(computed: list[str]) -> None:
+    for _ in range(2):
+        with pytest.raises(jobs.JobError, match="no-such-model"):
+            jobs.call("path_table", "no-such-model", np.zeros(3))
+    assert computed == ["path_table"] * 2
+
+
+def test_an_unknown_job_is_refused_in_this_process(computed: list[str]) -> None:
+    with pytest.raises(jobs.JobError, match="no job named 'path_tabel'"):
+        jobs.call("path_tabel", "trep", np.zeros(2))
+    assert computed == []
 
 
 def test_the_least_recently_used_reply_leaves_first_within_the_byte_budget() -> None:

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
 
 import numpy as np
 import pytest
@@ -37,18 +36,19 @@ def test_a_reach_request_overtakes_the_gain_explorers_sweep(monkeypatch: pytest.
 
     started: list[str] = []  # the helper's jobs in the order they got it
     mid_sweep = threading.Event()
-    exchange = jobs._Helper._exchange
+    run = jobs._Helper._run
 
-    def watched(helper: jobs._Helper, name: str, args: tuple[Any, ...]) -> tuple[bool, Any]:
+    def watched(helper: jobs._Helper, name: str, request: bytes) -> bytes:
         started.append(name)
         if name == "linear_loops" and started.count("linear_loops") == 2:
             mid_sweep.set()  # the sweep's second call holds the helper until the reach request waits
             deadline = time.monotonic() + 120.0
             while not helper.urgent_waiting and time.monotonic() < deadline:
                 time.sleep(0.005)
-        return exchange(helper, name, args)
+        return run(helper, name, request)
 
-    monkeypatch.setattr(jobs._Helper, "_exchange", watched)
+    monkeypatch.setattr(jobs._Helper, "_run", watched)
+    monkeypatch.setattr(jobs._helper, "cache", jobs.ReplyCache())  # every request computed here
     explorer, background = GainExplorer(), Background()
     try:
         explorer.context(0, "boom7", "acceleration", theta0, gains)

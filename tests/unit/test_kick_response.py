@@ -19,8 +19,6 @@ from rns_viz.model import FsmsModel
 from rns_viz.sim import ForcePulse, Simulator
 from tests.support.kick_oracle import kick_cell
 
-RNG = np.random.default_rng(31)
-
 
 def stepped(loop, g_b: float, g_m: float, seconds: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The linear step map x_{k+1} = A x_k + B f_k under the loop's kick, stepped for ``seconds``:
@@ -92,7 +90,8 @@ def test_the_maps_numbers_are_the_linear_step_maps(
     m, loop = grid.modes, grid.loop
     cells = np.argwhere(m.stable & (m.base_time_to_10pct < 8.0))
     worst = np.zeros(4)
-    for i, j in cells[RNG.choice(len(cells), 6, replace=False)]:
+    rng = np.random.default_rng(31)  # each case its own draw: the cells must not depend on which tests ran first
+    for i, j in cells[rng.choice(len(cells), 6, replace=False)]:
         settle = float(m.base_time_to_10pct[i, j])
         t, y, integral = stepped(loop, grid.g_b[i], grid.g_m[j], loop.kick.duration + 1.6 * settle + 1.0)
         got = measure_kick(t, y, loop.kick.duration, quiet=0.3 * settle)

@@ -3,8 +3,8 @@ tests/session/test_lessons_boom.py)."""
 
 from __future__ import annotations
 
-from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.live.teaching.lessons import lessons_for
 
 
 def test_boom7_has_three_lessons() -> None:
-    assert [lesson.start.model for lesson in LESSONS["boom7"]] == ["boom7", "boom7", "boom7#S=111000"]
+    assert [lesson.start.model for lesson in lessons_for("boom7")] == ["boom7", "boom7", "boom7#S=111000"]

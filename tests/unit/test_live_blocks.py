@@ -15,11 +15,11 @@ import pytest
 
 from rns_viz.control import Gains, InvalidGain, JointSample, TaskSample
 from rns_viz.live.loop import commands as c
-from rns_viz.live.operator.operator import UNCHANGED, InputRefused, Operator
-from rns_viz.live.reach.path_table import build_path_table
+from rns_viz.live.operator.kinds import operator_class
+from rns_viz.live.operator.operator import UNCHANGED, InputRefused
 from rns_viz.live.runs.run_pair import LawChoice, RunPair
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField
+from rns_viz.paths import CouplingField, build_path_table
 from rns_viz.rns import null_vector
 
 DT = 1e-3
@@ -83,7 +83,7 @@ def trep_table(trep: FsmsModel):  # type: ignore[no-untyped-def]
 
 def test_operator_holds_until_told(trep: FsmsModel) -> None:
     theta0 = trep.spec.default_configuration
-    op = Operator(trep, theta0, 30.0, 0.5)
+    op = operator_class(trep)(trep, theta0, 30.0, 0.5)
     first = op.joint
     for k in range(5):
         assert op.advance(k * DT, DT) == UNCHANGED
@@ -94,7 +94,7 @@ def test_operator_holds_until_told(trep: FsmsModel) -> None:
 
 def test_scrubbed_reference_stays_on_the_reactionless_path(trep: FsmsModel, trep_table) -> None:  # type: ignore[no-untyped-def]
     theta0 = trep.spec.default_configuration
-    op = Operator(trep, theta0, 30.0, 0.5)
+    op = operator_class(trep)(trep, theta0, 30.0, 0.5)
     assert op.accept_table(trep_table, 1e-6)
     field = CouplingField(trep)
     level = field.potentials(np.asarray(theta0)[None])[0]
@@ -122,7 +122,7 @@ def test_scrubbed_reference_stays_on_the_reactionless_path(trep: FsmsModel, trep
 
 
 def test_point_to_point_reports_its_start_and_end(trep: FsmsModel, trep_table) -> None:  # type: ignore[no-untyped-def]
-    op = Operator(trep, trep.spec.default_configuration, 30.0, 0.5)
+    op = operator_class(trep)(trep, trep.spec.default_configuration, 30.0, 0.5)
     op.accept_table(trep_table, 1e-6)
     op.point_to_point(0.0, duration=0.05)
     end = op.joint_move.end.copy()  # type: ignore[union-attr]
@@ -137,7 +137,7 @@ def test_point_to_point_reports_its_start_and_end(trep: FsmsModel, trep_table) -
 
 
 def test_operator_of_a_planar_3r_tracks_a_dragged_target(planar3r: FsmsModel) -> None:
-    op = Operator(planar3r, planar3r.spec.default_configuration, 30.0, 0.5)
+    op = operator_class(planar3r)(planar3r, planar3r.spec.default_configuration, 30.0, 0.5)
     assert isinstance(op.task, TaskSample)
     start = op.task.x.copy()
     goal = start + np.array([-0.05, 0.05])
@@ -180,9 +180,38 @@ def test_a_kick_reaches_both_runs_alike_without_suppression(trep: FsmsModel) -> 
 
 # ---------------------------------------------------------------- inputs that are moved
 def test_a_target_off_the_path_is_moved_onto_it_and_said(trep: FsmsModel, trep_table) -> None:  # type: ignore[no-untyped-def]
-    op = Operator(trep, trep.spec.default_configuration, 30.0, 0.5)
+    op = operator_class(trep)(trep, trep.spec.default_configuration, 30.0, 0.5)
     op.accept_table(trep_table, 1e-6)
     on_path = trep_table.ee_at(op.sigma + 0.3)[:2]
     assert op.drag(on_path, final=True) is False  # on the path: nothing to say
     assert op.drag(np.array([1.0, 1.0]), final=True) is True  # far from this path: moved onto it
     assert np.linalg.norm(op.target[:2] - trep_table.ee_at(op.motion.goal)[:2]) < 1e-12  # type: ignore[index]
+
+
+@pytest.mark.parametrize(
+    ("key", "kind", "follows", "shows"),
+    [
+        ("trep", "reactionless path", "path", "path"),  # n - r = 1
+        ("planar3r", "reachable set", "target", "reachable set"),  # n - r = 2
+        ("boom7", "reactionless path", "path", "path"),  # r = 6, n = 7
+        ("boom7#S=111000", "reachable set", "target", "reachable set"),  # forces only: n - r = 4
+        ("trep2", "task arm", "target", "workspace"),  # [arms]: a compensating arm
+    ],
+)
+def test_what_the_operator_drives_is_chosen_once_from_the_rns_and_the_arms(
+    key: str, kind: str, follows: str, shows: str
+) -> None:
+    model = FsmsModel.from_key(key)
+    cls = operator_class(model)
+    assert (cls.kind, cls.follows, cls.shows, cls.compensates) == (kind, follows, shows, kind == "task arm")
+    op = cls(model, model.spec.default_configuration, 30.0, 0.5)
+    assert (op.task is None) == (follows == "path")  # a path is followed in joint space, a target in task space
+    if follows == "target":  # no path to scrub on a target's model: refused with a reason, not waited for
+        with pytest.raises(InputRefused, match="No reactionless path"):
+            op.scrub(0.1)
+    for law in ("acceleration", "torque", "velocity"):
+        if kind == "task arm" and law != "acceleration":
+            with pytest.raises(ValueError, match="compensating law"):
+                cls.check_law(key, law)
+        else:
+            cls.check_law(key, law)

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rns_viz.live.reach.path_table import PathTable, build_path_table
 from rns_viz.model import FsmsModel
+from rns_viz.paths import PathTable, build_path_table
 from rns_viz.rns import null_vector
 
 SEEDS = {"default": None, "elsewhere": np.array([0.6, 1.9])}  # rad; the second off the zero level

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from rns_viz.live.teaching.rank_view import arm_pose, rank_overlay
+from rns_viz.live.teaching.rank_view import rank_overlay
 from rns_viz.model import FsmsModel
 from rns_viz.rank import kernel_coupling
 
@@ -28,7 +28,7 @@ def test_every_drawn_pose_has_lost_rank(name: str, count: int, bundled_model: Ca
     for theta, pose in zip(overlay.theta, overlay.poses, strict=True):
         sigma = np.linalg.svd(model.coupling_matrix(model.q(theta)), compute_uv=False)[-1]
         assert sigma <= 1e-9 * overlay.scale
-        np.testing.assert_allclose(pose, arm_pose(model, theta), atol=1e-15)
+        np.testing.assert_allclose(pose, model.arm_points(theta), atol=1e-15)
         np.testing.assert_allclose(pose[-1], model.ee_position(theta), atol=1e-12)
         assert np.abs(pose[:, 1]).max() < 1e-9  # every point of the drawn pose on the deflection axis
         assert kernel_coupling(model, theta)[0] <= 1e-9 * overlay.scale  # kernel velocity: no coupling

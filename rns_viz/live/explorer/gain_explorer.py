@@ -40,7 +40,7 @@ from rns_viz.analysis import (
 from rns_viz.control import Gains, LawKind
 from rns_viz.live.jobs import helper as jobs
 from rns_viz.live.jobs.worker import Worker
-from rns_viz.live.operator.dual_arm import dual_by_name
+from rns_viz.live.operator.kinds import operator_class_of
 from rns_viz.sim import Simulator
 
 AUTHORITY_POINTS = 80  # configurations along the path / over the set where the decay is predicted
@@ -130,7 +130,7 @@ class GainExplorer:
             changes["measured"] = None
             self._forget_kick()
         # a compensating arm's model: its linearised loop would be law (15)'s on all joints, not the compensating law
-        analysed = not dual_by_name(model)
+        analysed = not operator_class_of(model).compensates
         self._publish(gains=gains, paper=paper, analysed=analysed, **changes, **_NOTHING_AT_KEY)
         if not analysed:
             return

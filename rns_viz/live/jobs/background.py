@@ -14,8 +14,8 @@ import numpy as np
 
 from rns_viz.live.jobs import helper as jobs
 from rns_viz.live.jobs.worker import Worker
-from rns_viz.live.reach.path_table import PathTable
 from rns_viz.live.reach.region import ReachRegion
+from rns_viz.paths import PathTable
 from rns_viz.scenarios import LIVE_SCENARIOS
 from rns_viz.sim import Simulator
 

@@ -1,41 +1,42 @@
 """Slow geometry for the live session, computed in a helper process.
 
-A Python-heavy computation in a thread would take turns with the simulation thread for the GIL
-and slow it down; a separate process runs beside it on another core. The helper is
-``python -m rns_viz.live.jobs.helper`` (a plain subprocess, so no caller needs a ``__main__`` guard),
-speaking length-prefixed pickles over its stdin and stdout. :func:`call` runs one job there,
-blocking the calling thread (not the GIL) until the result is back; the helper is started on
-first use, restarted if it died, and shared by all sessions of the process.
+A Python-heavy computation in a thread would take turns with the simulation thread for the GIL and
+slow it down; a process runs beside it on another core. The helper is a
+:class:`~concurrent.futures.ProcessPoolExecutor` of one process (spawned: it imports this module, not
+the parent's main script), started on first use, shared by all sessions of the process, and started
+again by the call after it died. :func:`call` runs one job there, blocking the calling thread (not the
+GIL) until the result is back.
 
-One helper runs one job at a time. The gain explorer's linearisations (:data:`BACKGROUND_JOBS`) yield
-to every other job: a caller of those waits while one of the others waits, so a reachable set asked
-for after a change of S waits for at most the one explorer call in flight (the explorer cuts its
-sweep over a path into calls of a few configurations, rns_viz.live.explorer.gain_explorer).
+One job runs at a time. The gain explorer's linearisations (:data:`BACKGROUND_JOBS`) yield to every
+other job: a caller of those waits while one of the others waits, so a reachable set asked for after a
+change of S waits for at most the one explorer call in flight (the explorer cuts its sweep over a path
+into calls of a few configurations, rns_viz.live.explorer.gain_explorer).
 
 Jobs are the top-level functions below: plain arguments, picklable results. Each is a function of its
-arguments (and the model file), so the helper answers a request it has already answered from its
-:class:`ReplyCache`.
+arguments (and the model file), so a request answered before is answered again from the
+:class:`ReplyCache` of this process, without the helper.
 """
 
 from __future__ import annotations
 
-import atexit
 import pickle
-import struct
-import subprocess
 import sys
 import threading
 from collections import OrderedDict
-from typing import IO, Any
+from collections.abc import Iterator
+from concurrent.futures import BrokenExecutor, Future, ProcessPoolExecutor
+from contextlib import contextmanager
+from multiprocessing import active_children, get_context
+from multiprocessing.process import BaseProcess
+from typing import Any
 
 import numpy as np
 
 from rns_viz.analysis import GainMap, LinearLoop, linearise, loops_along, map_of
 from rns_viz.control import LawKind
-from rns_viz.live.reach.path_table import PathTable, build_path_table
 from rns_viz.live.reach.region import ReachRegion, build_reach_region
 from rns_viz.model import FsmsModel
-from rns_viz.paths import path_family
+from rns_viz.paths import PathTable, build_path_table, path_family
 
 _models: dict[str, FsmsModel] = {}
 
@@ -82,28 +83,63 @@ BACKGROUND_JOBS = frozenset({"linear_loop", "loop_and_map", "linear_loops"})  # 
 
 
 class JobError(RuntimeError):
-    """A job failed in the helper process (the message carries its error)."""
+    """A job failed, or the helper process died while running it (the message says which)."""
 
 
-def _write(stream: IO[bytes], obj: Any) -> None:
-    _write_bytes(stream, pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL))
+def _compute(request: bytes) -> bytes:
+    """Run a pickled request (job name, arguments) in the helper process; the result comes back pickled,
+    as the cache keeps it."""
+    name, args = pickle.loads(request)
+    return pickle.dumps(JOBS[name](*args), protocol=pickle.HIGHEST_PROTOCOL)
 
 
-def _write_bytes(stream: IO[bytes], data: bytes) -> None:
-    stream.write(struct.pack("<Q", len(data)) + data)
-    stream.flush()
+@contextmanager
+def _main_script_hidden() -> Iterator[None]:
+    """While the helper is spawned: multiprocessing would have it import the parent's main script again
+    (the top level of a script without a ``__main__`` guard would run twice; the app's would import viser
+    for nothing). The helper needs this module only."""
+    main = sys.modules["__main__"]
+    spec, file = getattr(main, "__spec__", None), main.__dict__.pop("__file__", None)
+    main.__spec__ = None
+    try:
+        yield
+    finally:
+        main.__spec__ = spec
+        if file is not None:
+            main.__file__ = file
 
 
-def _read(stream: IO[bytes]) -> Any:
-    return pickle.loads(_read_bytes(stream))
+class ReplyCache:
+    """The last replies by request bytes, at most ``budget`` bytes of them (least recently used leave first).
 
+    Every job is a function of its arguments and the model file, so a request seen before is answered
+    from here: a reset, a lesson restarted or a model switched back gets its path table, reachable set
+    and gain map at once instead of in seconds (a planar 3R's reachable set: ~1 s). Each caller unpickles
+    its own copy of the reply.
+    """
 
-def _read_bytes(stream: IO[bytes]) -> bytes:
-    header = stream.read(8)
-    if len(header) < 8:
-        raise EOFError("the job helper closed its pipe")
-    (size,) = struct.unpack("<Q", header)
-    return stream.read(size)
+    def __init__(self, budget: int = CACHE_BYTES) -> None:
+        self.budget = budget
+        self._replies: OrderedDict[bytes, bytes] = OrderedDict()
+        self._size = 0
+        self._lock = threading.Lock()
+
+    def get(self, request: bytes) -> bytes | None:
+        with self._lock:
+            reply = self._replies.get(request)
+            if reply is not None:
+                self._replies.move_to_end(request)
+            return reply
+
+    def put(self, request: bytes, reply: bytes) -> None:
+        with self._lock:
+            if request in self._replies or len(request) + len(reply) > self.budget:
+                return
+            self._replies[request] = reply
+            self._size += len(request) + len(reply)
+            while self._size > self.budget:
+                old, old_reply = self._replies.popitem(last=False)
+                self._size -= len(old) + len(old_reply)
 
 
 class _Helper:
@@ -111,9 +147,21 @@ class _Helper:
         self.cv = threading.Condition()
         self.busy = False  # a job is in the helper
         self.urgent_waiting = 0  # callers of jobs outside BACKGROUND_JOBS waiting for the helper
-        self.proc: subprocess.Popen[bytes] | None = None
+        self.pool: ProcessPoolExecutor | None = None
+        self.processes: list[BaseProcess] = []  # the pool's process
+        self.cache = ReplyCache()
 
     def call(self, name: str, *args: Any) -> Any:
+        if name not in JOBS:
+            raise JobError(f"no job named {name!r}")
+        request = pickle.dumps((name, args), protocol=pickle.HIGHEST_PROTOCOL)
+        reply = self.cache.get(request)
+        if reply is None:
+            reply = self._gated(name, request)
+        return pickle.loads(reply)
+
+    def _gated(self, name: str, request: bytes) -> bytes:
+        """The reply computed in the helper once it is this caller's turn (or found in the cache by then)."""
         urgent = name not in BACKGROUND_JOBS
         with self.cv:
             self.urgent_waiting += urgent
@@ -123,115 +171,59 @@ class _Helper:
                 self.urgent_waiting -= urgent
             self.busy = True
         try:
-            ok, value = self._exchange(name, args)
+            reply = self.cache.get(request)  # the same request, answered while this caller waited
+            if reply is None:
+                reply = self._run(name, request)
+                self.cache.put(request, reply)
+            return reply
         finally:
             with self.cv:
                 self.busy = False
                 self.cv.notify_all()
-        if not ok:
-            raise JobError(value)
-        return value
 
-    def _exchange(self, name: str, args: tuple[Any, ...]) -> tuple[bool, Any]:
-        """Send one job and read its reply (restarting a dead helper once); the caller holds the helper."""
-        for attempt in range(2):
-            proc = self._running()
-            try:
-                assert proc.stdin is not None and proc.stdout is not None
-                _write(proc.stdin, (name, args))
-                return _read(proc.stdout)
-            except (EOFError, BrokenPipeError, OSError):
-                self.close()
-                if attempt:
-                    raise JobError(f"the job helper died while running {name}") from None
-        raise AssertionError("unreachable")
+    def _run(self, name: str, request: bytes) -> bytes:
+        """Run one job in the helper and wait for it; the caller holds the helper."""
+        try:
+            return self._submit(request).result()
+        except BrokenExecutor:
+            self.close()
+            raise JobError(f"the job helper died while running {name}; it starts again on the next call") from None
+        except Exception as exc:
+            raise JobError(f"{name}: {type(exc).__name__}: {exc}") from exc
 
-    def _running(self) -> subprocess.Popen[bytes]:
-        if self.proc is None or self.proc.poll() is not None:
-            self.proc = subprocess.Popen(
-                [sys.executable, "-m", "rns_viz.live.jobs.helper"], stdin=subprocess.PIPE, stdout=subprocess.PIPE
-            )
-        return self.proc
+    def _submit(self, request: bytes) -> Future[bytes]:
+        """The future of ``request`` in the helper, which is started first if there is none or it died
+        while idle (not this job's doing, so the job gets a new one)."""
+        if self.pool is not None and not all(p.is_alive() for p in self.processes):
+            self.close()
+        if self.pool is not None:
+            return self.pool.submit(_compute, request)
+        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
+        before = set(active_children())
+        with _main_script_hidden():  # the helper is spawned by its first submit
+            future = self.pool.submit(_compute, request)
+        self.processes = [p for p in active_children() if p not in before]
+        return future
 
     def close(self) -> None:
-        proc, self.proc = self.proc, None
-        if proc is not None and proc.poll() is None:
-            try:
-                proc.stdin.close()  # type: ignore[union-attr]
-                proc.wait(timeout=2.0)
-            except Exception:
-                proc.kill()
+        """Let the helper go: it ends once a job in flight is done (that job's result is dropped)."""
+        pool, self.pool = self.pool, None
+        if pool is not None:
+            pool.shutdown(wait=False, cancel_futures=True)
+
+    def kill(self) -> None:
+        """End the helper now, a job in flight with it (its caller gets a JobError)."""
+        for process in self.processes:
+            process.kill()
+        self.close()
 
 
 _helper = _Helper()
-atexit.register(_helper.close)
+# At exit the executor's own hook waits for a job in flight (seconds for boom7's geometry); this hook,
+# registered after it, runs before it and ends the helper instead.
+threading._register_atexit(_helper.kill)  # type: ignore[attr-defined]
 
 
 def call(name: str, *args: Any) -> Any:
     """Run job ``name`` with ``args`` in the helper process and return its result (JobError if it failed)."""
     return _helper.call(name, *args)
-
-
-class ReplyCache:
-    """The last replies by request bytes, at most ``budget`` bytes of them (least recently used leave first).
-
-    Every job is a function of its arguments and the model file, so a request seen before is answered
-    from here: a reset, a lesson restarted or a model switched back gets its path table, reachable set
-    and gain map at once instead of in seconds (a planar 3R's reachable set: ~1 s).
-    """
-
-    def __init__(self, budget: int = CACHE_BYTES) -> None:
-        self.budget = budget
-        self._replies: OrderedDict[bytes, bytes] = OrderedDict()
-        self._size = 0
-
-    def get(self, request: bytes) -> bytes | None:
-        reply = self._replies.get(request)
-        if reply is not None:
-            self._replies.move_to_end(request)
-        return reply
-
-    def put(self, request: bytes, reply: bytes) -> None:
-        if request in self._replies or len(request) + len(reply) > self.budget:
-            return
-        self._replies[request] = reply
-        self._size += len(request) + len(reply)
-        while self._size > self.budget:
-            old, old_reply = self._replies.popitem(last=False)
-            self._size -= len(old) + len(old_reply)
-
-
-def _answer(request: bytes) -> tuple[bytes, bool]:
-    """The pickled reply to one pickled request, and whether it may be cached (failures are not)."""
-    name, args = pickle.loads(request)
-    try:
-        reply: tuple[bool, Any] = (True, JOBS[name](*args))
-    except Exception as exc:
-        reply = (False, f"{name}: {type(exc).__name__}: {exc}")
-    return pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL), reply[0]
-
-
-def serve(stdin: IO[bytes], stdout: IO[bytes]) -> None:
-    """The helper's loop: read a job, run it (or find its reply in the cache), write (ok, result or error
-    text); stop at end of input."""
-    cache = ReplyCache()
-    while True:
-        try:
-            request = _read_bytes(stdin)
-        except EOFError:
-            return
-        reply = cache.get(request)
-        if reply is None:
-            reply, ok = _answer(request)
-            if ok:
-                cache.put(request, reply)
-        try:
-            _write_bytes(stdout, reply)
-        except BrokenPipeError:  # the caller's process ended while this job ran: nobody wants the result
-            return
-
-
-if __name__ == "__main__":
-    out = sys.stdout.buffer
-    sys.stdout = sys.stderr  # a stray print must not corrupt the pipe
-    serve(sys.stdin.buffer, out)

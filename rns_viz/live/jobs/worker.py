@@ -77,7 +77,8 @@ class Worker:
             try:
                 result = Result(kind, tag, job())
             except Exception as exc:  # a failed computation is reported, never fatal
-                traceback.print_exc()
+                if not self._stop:  # after stop (a helper ended at exit, say) nobody reads it
+                    traceback.print_exc()
                 result = Result(kind, tag, error=f"{type(exc).__name__}: {exc}")
             with self._cv:
                 self._done.append(result)

@@ -13,18 +13,19 @@ import math
 import time
 from dataclasses import dataclass, field, fields
 from types import MappingProxyType
-from typing import Any
+from typing import Any, get_args
 
 import numpy as np
 
 from rns_viz.control import Gains, InvalidGain, LawKind
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.outputs.recorder import MAX_RECORD_S
-from rns_viz.live.teaching.lessons import LESSONS
+from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
+from rns_viz.param_file import LawName
 from rns_viz.params import check_model_key, missing_extra
 from rns_viz.scenarios import LIVE_SCENARIOS
 
-LIVE_LAWS: tuple[LawKind, ...] = ("acceleration", "torque", "velocity")
+LIVE_LAWS: tuple[LawKind, ...] = get_args(LawName)  # the laws a parameter file may give gains for
 MAX_KICK_N = 1e4  # N: larger peaks are refused as input errors, not physics
 MAX_TARGET_M = 1e3  # m: a farther target is refused outright (it would mean nothing)
 MAX_UBAR_SPEED = 1e4  # 1/(kg m s)
@@ -284,9 +285,10 @@ class StartLesson(Command):
     number: int  # 1-based
 
     def __post_init__(self) -> None:
-        lessons = LESSONS.get(self.model)
-        if lessons is None:
-            raise ValueError(f"no lessons for model {self.model!r}; there are some for {', '.join(LESSONS)}")
+        lessons = lessons_for(check_model_key(self.model))
+        if not lessons:
+            there = ", ".join(models_with_lessons())
+            raise ValueError(f"no lessons for model {self.model!r}; there are some for {there}")
         if isinstance(self.number, bool) or not isinstance(self.number, int) or not 1 <= self.number <= len(lessons):
             raise ValueError(f"{self.model} has lessons 1 to {len(lessons)}, not {self.number!r}")
 

@@ -12,18 +12,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.live.operator.operator import InputRefused
+from rns_viz.integrability import check_integrability
+from rns_viz.live.operator.kinds import operator_class
+from rns_viz.live.operator.operator import InputRefused, Operator
 from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.divergence_guard import Bounds
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_key, model_source, spec_for_key
 from rns_viz.paths import CouplingField
-from rns_viz.rns import check_integrability
 
 
 @dataclass(frozen=True)
 class LoopModel:
     model: FsmsModel  # for references and readouts (the runs have their own instances)
+    kind: type[Operator]  # what the operator drives on it (a path, a reachable set, a task arm)
     field: CouplingField  # S H_bm and its potential at many configurations
     bounds: Bounds  # the divergence guard's physical bounds
     reach_m: float  # m: the arm's reach
@@ -34,7 +36,8 @@ class LoopModel:
         """Read model ``key``; raises ModelFileError (a ValueError) with the element at fault."""
         model = FsmsModel.from_key(key)
         reach = arm_reach(model)
-        return cls(model, CouplingField(model), Bounds(model), reach, 1e-4 * model.arm_mass * reach)
+        kind = operator_class(model)
+        return cls(model, kind, CouplingField(model), Bounds(model), reach, 1e-4 * model.arm_mass * reach)
 
     def copy_model(self) -> FsmsModel:
         """Another instance of the same (already checked) model, with its own pinocchio data."""
@@ -52,7 +55,7 @@ def key_of(model: FsmsModel) -> str:
 
 def integrability_note(model: FsmsModel, theta: np.ndarray) -> str:
     """Frobenius test of the RNS distribution at ``theta`` (Lie brackets of the columns of P_RNS), in words."""
-    test = check_integrability(lambda th: model.coupling_matrix(model.q(th)), np.asarray(theta, dtype=float))
+    test = check_integrability(model.coupling_at, np.asarray(theta, dtype=float))
     if test.integrable:
         return f"Lie brackets here: the RNS distribution is integrable (residual {test.max_residual:.1e})."
     return (

@@ -25,7 +25,7 @@ def make_snapshot(
     sim = runs.sim
     epoch, settings_version, target_version, overlay_version = versions
     paused, diverged, rtf, behind = flags
-    table = op.table if op is not None and op.on_path else None
+    table = op.table if op is not None else None
     mode, target = (op.mode, op.target) if op is not None else (f"preset {settings.preset}", None)
     readouts = replace(
         out.readouts, reaction=out.reaction, reaction_t=out.reaction_t, reaction_wrench=out.reaction_wrench

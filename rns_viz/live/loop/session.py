@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from rns_viz.csvio import csv_text
 from rns_viz.live.explorer.gain_explorer import GainView
 from rns_viz.live.loop import commands as c
 from rns_viz.live.loop.state import LiveState
@@ -36,7 +37,7 @@ from rns_viz.live.published.snapshot import Notice, Overlays, Snapshot
 from rns_viz.params import check_model_key
 from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S
 
-PUBLISH_EVERY = 8  # steps between snapshots (125 Hz: two or more per 60 Hz frame; a snapshot costs ~30 us)
+PUBLISH_EVERY = 8  # steps between snapshots (125 Hz: two or more per 60 Hz frame)
 BURST_S = 0.003  # wall s: when ahead, the loop sleeps until this much simulation is due (commands wake it)
 
 
@@ -95,15 +96,12 @@ class Session:
         return list(self._latencies)
 
     def log_csv(self, last_seconds: float | None = None) -> bytes:
-        """The operated run's step log as CSV (StepLog's columns), the newest ``last_seconds``."""
-        with self._lock:
+        """The operated run's step log as CSV (rns_viz.csvio: units in the header, 17 significant digits),
+        the newest ``last_seconds``."""
+        with self._lock:  # the rows copied under the lock, written out after it
             log = self.state.runs.sim.log
-            columns = list(log.columns)
             rows = log.array(None if last_seconds is None else round(last_seconds / self.dt))
-        lines = [",".join(columns)]
-        fmt = ",".join(["%.10g"] * len(columns))
-        lines.extend(fmt % tuple(row) for row in rows)
-        return ("\n".join(lines) + "\n").encode()
+        return csv_text(log.columns, log.units, rows).encode()
 
     def recording(self, seconds: float) -> Recording | None:
         """The newest ``seconds`` (at most 60) of the run as an immutable recording (None: nothing yet).

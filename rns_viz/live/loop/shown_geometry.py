@@ -10,12 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 from rns_viz.live.jobs.background import Background
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.operator import Operator
 from rns_viz.live.published.snapshot import Overlays
-from rns_viz.live.reach.path_table import PathTable
 from rns_viz.live.reach.region import ReachRegion
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField
+from rns_viz.paths import CouplingField, PathTable
 
 
 class Geometry:
@@ -32,16 +31,16 @@ class Geometry:
         self.shown_level: np.ndarray | None = None  # coupling potential of what is shown, kg m
 
     def request(
-        self, model: FsmsModel, field: CouplingField, epoch: int, theta: np.ndarray, default: bool = False
+        self, kind: type[Operator], model: FsmsModel, field: CouplingField, epoch: int, theta: np.ndarray, default: bool
     ) -> None:
-        """The current reactionless path (1-D RNS) or reachable set (otherwise) through ``theta``."""
+        """What the operator's ``kind`` shows through ``theta``: the current reactionless path (1-D RNS) or the
+        reachable set (otherwise); nothing for a task arm, which goes anywhere in its workspace."""
         self.shown_level = field.potentials(np.asarray(theta, dtype=float)[None])[0]
-        if is_dual(model):  # the task arm goes anywhere in its workspace: no reactionless set to show
-            return
-        if model.n - len(model.selected) == 1:
+        shows = kind.shows
+        if shows == "path":
             self.background.path_table(epoch, model.name, theta, default)
             self.background.family(epoch, model.name)
-        else:  # on the potential's level set (a translating base) or along the distribution (one that turns)
+        elif shows == "reachable set":  # on the potential's level set (a translating base) or along the distribution
             self.background.reach(epoch, model.name, theta)
 
     def took_table(self, model: str, table: PathTable, default: bool) -> None:

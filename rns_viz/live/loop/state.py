@@ -21,17 +21,16 @@ from rns_viz.live.loop.replay_mode import apply_replay
 from rns_viz.live.loop.settle import settled_elsewhere
 from rns_viz.live.loop.shown_geometry import Geometry
 from rns_viz.live.loop.wall_clock import Pacer
-from rns_viz.live.operator.dual_arm import refuse_other_laws
 from rns_viz.live.operator.operator import InputRefused, Operator, PathNotReady
 from rns_viz.live.outputs.step_outputs import Outputs
 from rns_viz.live.published.snapshot import Level, Notice, ReplayView, Settings, Snapshot
-from rns_viz.live.reach.path_table import PathTable
 from rns_viz.live.runs.divergence_guard import GUARD_EVERY
 from rns_viz.live.runs.kicks import kick_pulse
 from rns_viz.live.runs.run_pair import LawChoice, RunPair, ShadowDiverged
 from rns_viz.live.teaching.lesson_run import OBSERVE_EVERY, LessonRun, run_view
 from rns_viz.model import FsmsModel
 from rns_viz.params import model_source
+from rns_viz.paths import PathTable
 from rns_viz.scenarios import LIVE_SCENARIOS
 
 SETTLE_EVERY = 100  # steps between checks whether the arm settled on another path
@@ -50,8 +49,9 @@ class LiveState:
         self.paused = False
         self.diverged: str | None = None
         self.replay: ReplayView | None = None  # a replay shown while the simulation waits (live/loop/replay_mode.py)
-        self.settings = Settings.defaults(model, shadow, pacer.speed)
         self.aux: FsmsModel | None = None
+        self._use_model(model)  # a bad model file raises here
+        self.settings = Settings.defaults(self.model, shadow, pacer.speed)
         self.lesson: LessonRun | None = None
         self.kicks_sent = self.targets_moved = 0  # kicks, dragged targets moved onto the path / into the set
         self._preset_paused = False  # the preset being built starts paused
@@ -63,7 +63,7 @@ class LiveState:
         if self.aux is None or self.aux.name != name:
             loaded = LoopModel.load(name)
             self.aux, self.field, self.bounds = loaded.model, loaded.field, loaded.bounds
-            self.reach_m, self.tol = loaded.reach_m, loaded.tol
+            self.operator_kind, self.reach_m, self.tol = loaded.kind, loaded.reach_m, loaded.tol
 
     @property
     def model(self) -> FsmsModel:
@@ -92,7 +92,7 @@ class LiveState:
 
     def _new_operator(self, theta: np.ndarray) -> None:
         st = self.settings
-        self.operator: Operator | None = Operator(self.model, theta, st.ubar_speed, st.target_speed)
+        self.operator: Operator | None = self.operator_kind(self.model, theta, st.ubar_speed, st.target_speed)
         self._install_live_laws()
 
     def _install_live_laws(self) -> None:
@@ -103,7 +103,7 @@ class LiveState:
     def _restart_bookkeeping(self) -> None:
         """A new epoch (reset, model switch, preset, selection); a lesson goes on only on its own model."""
         self.epoch += 1
-        if self.lesson is not None and model_source(self.model.name) != self.lesson.model:
+        if self.lesson is not None and model_source(self.model.name) != self.lesson.home:
             self.lesson = None
         self.settings_version += 1
         self.target_version += 1
@@ -135,7 +135,7 @@ class LiveState:
         self.runs, self.operator = runs, None
         choice = runs.adopt_preset_laws()
         st = self.settings
-        defaults = Settings.defaults(self.model.name, st.shadow, st.speed)
+        defaults = Settings.defaults(self.model, st.shadow, st.speed)
         self.settings = replace(defaults, law=choice.kind, gains=choice.gains, suppress=choice.suppress, preset=name)
         self._restart_bookkeeping()
         self.paused = self._preset_paused
@@ -144,7 +144,7 @@ class LiveState:
 
     def _request_geometry(self, theta: np.ndarray, default: bool = False) -> None:
         """The path or reachable set through ``theta``, and the gain analysis about it."""
-        self.geometry.request(self.model, self.field, self.epoch, theta, default)
+        self.geometry.request(self.operator_kind, self.model, self.field, self.epoch, theta, default)
         self._explore(theta)
 
     def _explore(self, theta: np.ndarray) -> None:
@@ -200,7 +200,7 @@ class LiveState:
                 self.pacer.set_speed(speed, self.runs.t)
                 self.settings = replace(st, speed=speed)
             case c.Kick(peak=peak, direction=direction):
-                duration = defaults_for(st.model).kick_duration_s
+                duration = defaults_for(self.model).kick_duration_s
                 self.runs.kick(kick_pulse(self.runs.t, peak, duration, self.runs.model.m, direction))
                 self.kicks_sent += 1
                 self.explorer.kicked(self.runs.t, duration, direction, st.suppress)
@@ -212,9 +212,9 @@ class LiveState:
                     self.explorer.forget_measurement()
                 self.settings = replace(st, suppress=on)
             case c.SetLaw(law=law):
-                refuse_other_laws(self.model, law)
+                self.operator_kind.check_law(self.model.name, law)
                 self._gain_memory[(st.model, st.law)] = st.gains
-                gains = self._gain_memory.get((st.model, law), defaults_for(st.model).gains_for(law))
+                gains = self._gain_memory.get((st.model, law), defaults_for(self.model).gains_for(law))
                 self.settings = replace(st, law=law, gains=gains)
                 if self.operator is None:
                     self._go_live()
@@ -254,7 +254,7 @@ class LiveState:
                 self.target_version += 1
             case c.SwitchModel(model=name):
                 self._use_model(name)  # a bad file stops here, the running model untouched
-                self.settings = Settings.defaults(name, st.shadow, st.speed)
+                self.settings = Settings.defaults(self.model, st.shadow, st.speed)
                 self.start_live(name)
             case c.SetSelection(flags=flags):  # the same system with another S, at rest where the arm is
                 key, note = selection_key(self.model, flags, self.runs.theta)
@@ -380,8 +380,8 @@ class LiveState:
                     if waiting is not None:
                         self.apply(waiting)
                 case ReachReady(region=region):
-                    if self.operator is not None and not self.operator.on_path:
-                        self.operator.reach = region
+                    if self.operator is not None:
+                        self.operator.take_reach(region)
                     self.geometry.took_reach(region)
                     self.explorer.along(self.model.name, region.thetas, region.points)
                     self._overlays_changed()

@@ -16,10 +16,7 @@ For a model with ``[arms]`` (trep2) the live session runs :class:`~rns_viz.contr
 
 from __future__ import annotations
 
-from functools import cache
-
 import numpy as np
-import pinocchio as pin
 
 from rns_viz.control import ControlOutput, Gains, TaskSample
 from rns_viz.control.compensation import CompensatingLaw
@@ -35,12 +32,6 @@ CANCEL_RATIO = 0.05  # a residual L above this fraction of the task arm's moment
 def is_dual(model: FsmsModel) -> bool:
     """The model has a task arm and a compensating arm (``[arms]`` of its parameter file)."""
     return "task" in model.arm_groups and "compensating" in model.arm_groups
-
-
-@cache
-def dual_by_name(key: str) -> bool:
-    """:func:`is_dual` of the model a model key names (bundled or a file, with its S)."""
-    return is_dual(FsmsModel.from_key(key))
 
 
 def dual_law(model: FsmsModel, gains: Gains, suppress: bool, task: TaskSample | None, shadow: bool) -> CompensatingLaw:
@@ -74,16 +65,8 @@ class TaskWorkspace:
     """The task arm's reachable annulus about its first joint, base frame (planar x, y), m."""
 
     def __init__(self, model: FsmsModel) -> None:
-        pm = model.pin_model
-        data = pm.createData()
-        pin.forwardKinematics(pm, data, model.q(model.spec.default_configuration))
-        pin.updateFramePlacements(pm, data)
-        base = data.oMi[model.base_joint_id]
-        names = [model.arm_joint_names[i] for i in model.arm_groups["task"].index]
-        points = [data.oMi[pm.getJointId(name)].translation for name in names] + [
-            data.oMf[model.ee_frame_id].translation
-        ]
-        xy = np.array([(base.rotation.T @ (p - base.translation))[:2] for p in points])
+        data = model.pin_model.createData()  # not the model's own: the loop's laws use that
+        xy = model.branch_points(model.spec.default_configuration, "task", data)[:, :2]
         lengths = np.linalg.norm(np.diff(xy, axis=0), axis=1)
         self.center = xy[0]
         reach = float(lengths.sum())
@@ -135,7 +118,7 @@ class TaskTarget(SmoothedTarget):
 def compensator_sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, float, int]:
     """S H_bm, the compensator's distance to singularity sigma_min(W S H_bm,2) (kg m, rns.singularity_distance),
     sigma_min(J_1) of the task arm, the RNS dimension."""
-    H = model.mass_matrix(model.q(theta))[model.selected, model.m :]
+    H = model.coupling_at(theta)
     comp, task = model.arm_groups["compensating"].index, model.arm_groups["task"].index
     J1 = model.ee_jacobian(theta)[:, task]
     sigma_2 = float(singularity_distance(H[:, comp], model.coupling_weights))
@@ -164,11 +147,3 @@ def compensation_state(model: FsmsModel, out: ControlOutput | None, v: np.ndarra
         rate, limit = abs(float(v[joints[k]])), float(model.pin_model.velocityLimit[joints[k]])
         return f"compensator beyond its speed: {rate:.1f} rad/s > its {limit:g} rad/s limit"
     return None
-
-
-def refuse_other_laws(model: FsmsModel, law: str) -> None:
-    """A dual-arm model runs the compensating law, resolved acceleration like (15): no other law choice."""
-    if is_dual(model) and law != "acceleration":
-        raise ValueError(
-            f"{model.name} runs the compensating law (resolved acceleration, like (15)); law {law!r} is not offered"
-        )

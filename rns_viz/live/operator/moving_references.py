@@ -5,7 +5,8 @@ immutable samples of them to both runs' laws, so the shadow sees the same operat
 
 - :class:`SigmaMotion`: sigma = integral of u-bar dt (Eq. 30) held, driven to a goal (scrub, drag),
   by a quintic (Fig. 11) or cyclically (Fig. 12).
-- :class:`PathFollower`: theta_ref on the reactionless path, d theta / d sigma = n(theta) by RK4.
+- :class:`PathFollower`: theta_ref on the reactionless path, d theta / d sigma = n(theta) by RK4
+  (:func:`~rns_viz.control.reference.along_path`).
 - :class:`ResolvedRate`: the reactionless resolved-rate reference of a multi-dimensional RNS,
   theta_ref' = J-bar(theta_ref)^+ (x_f' + k (x_f - x(theta_ref))) with a damped inverse, x_f the
   smoothed target (Eq. 24's J-bar = J P_RNS); in space, optionally an orientation target as a
@@ -17,12 +18,13 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from rns_viz.control.reference import along_path
 from rns_viz.live.operator.follower import ScalarFollower
 from rns_viz.live.operator.smoothed_target import SmoothedTarget
 from rns_viz.model import FsmsModel
 from rns_viz.paths import CouplingField
 from rns_viz.profiles import quintic
-from rns_viz.rns import DampedInverse, null_vector, rns_projector, svd_inverse, truncated_inverse
+from rns_viz.rns import DampedInverse, rns_projector, svd_inverse, truncated_inverse
 
 
 class SigmaMotion:
@@ -113,11 +115,13 @@ class PathFollower:
     potential it started on (Newton along H_bm), so rounding never walks it off the path.
     """
 
+    STEP = 0.01  # rad: the largest joint-space move of one RK4 step of :meth:`advance`
+    END_STEP = 0.2  # 1/(kg m): the largest sigma of one RK4 step of :meth:`end_point`
+
     def __init__(self, model: FsmsModel, theta: np.ndarray, project_every: int = 100) -> None:
         self.model = model
         self.data = model.pin_model.createData()
         self.field = CouplingField(model)
-        self._q = np.zeros(model.nv)
         self.project_every = project_every
         self.reset(theta)
 
@@ -130,27 +134,16 @@ class PathFollower:
 
     def n(self, theta: np.ndarray) -> np.ndarray:
         """Null-space vector n(theta), kg m (unnormalised)."""
-        m = self.model.m
-        self._q[m:] = theta
-        M = pin.crba(self.model.pin_model, self.data, self._q)
-        return null_vector(M[self.model.selected, m:])
+        return self.model.null_vector(theta, self.data)
 
     def advance(self, dsigma: float) -> None:
-        """Move theta by dsigma along the path: midpoint steps of at most 0.01 rad in joint space.
-
-        Per 1 ms step the joint-space move is ~1e-3 rad, so the midpoint rule's local error is far
-        below the periodic projection's correction; n at the new point is kept for :meth:`reference`.
-        """
+        """Move theta by dsigma along the path: RK4 steps of at most STEP rad in joint space; n at the new point
+        is kept for :meth:`reference`."""
         if dsigma == 0.0:
             return
-        th = self.theta
-        k1 = self._n_here if self._n_here is not None else self.n(th)
-        steps = max(1, int(np.ceil(abs(dsigma) * float(np.sqrt(k1 @ k1)) / 0.01)))
-        h = dsigma / steps
-        for i in range(steps):
-            if i:
-                k1 = self.n(th)
-            th = th + h * self.n(th + 0.5 * h * k1)
+        n_here = self._n_here if self._n_here is not None else self.n(self.theta)
+        steps = max(1, int(np.ceil(abs(dsigma) * float(np.sqrt(n_here @ n_here)) / self.STEP)))
+        th = along_path(self.model, self.theta, dsigma, steps, self.data, n_here)
         self._moves += 1
         if self._moves % self.project_every == 0:
             th = self.field.project(th[None], self.level.copy(), newton_steps=2)[0]
@@ -169,20 +162,11 @@ class PathFollower:
         return self.theta.copy(), rate, acc
 
     def end_point(self, dsigma: float) -> np.ndarray:
-        """theta after moving dsigma along the path, without moving this reference."""
-        saved, moves, n_here = self.theta, self._moves, self._n_here
-        th = self.theta
-        pieces = max(1, int(np.ceil(abs(dsigma) / 0.2)))
-        h = dsigma / pieces
-        for _ in range(pieces):  # RK4 in sigma, then back onto the level
-            k1 = self.n(th)
-            k2 = self.n(th + 0.5 * h * k1)
-            k3 = self.n(th + 0.5 * h * k2)
-            k4 = self.n(th + h * k3)
-            th = th + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        out = self.field.project(th[None], self.level.copy(), newton_steps=3)[0]
-        self.theta, self._moves, self._n_here = saved, moves, n_here
-        return out
+        """theta after moving dsigma along the path (RK4 steps of at most END_STEP, then back onto the level),
+        without moving this reference."""
+        steps = max(1, int(np.ceil(abs(dsigma) / self.END_STEP)))
+        th = along_path(self.model, self.theta, dsigma, steps, self.data)
+        return self.field.project(th[None], self.level.copy(), newton_steps=3)[0]
 
 
 class ResolvedRate(SmoothedTarget):
@@ -242,10 +226,7 @@ class ResolvedRate(SmoothedTarget):
 
     def ee_rotation(self, theta: np.ndarray) -> np.ndarray:
         """The end effector's orientation in the base frame at ``theta``."""
-        pm, data, m = self.model.pin_model, self.data, self.model.m
-        pin.forwardKinematics(pm, data, np.concatenate([np.zeros(m), theta]))
-        pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
-        return data.oMi[self.model.base_joint_id].rotation.T @ data.oMf[self.model.ee_frame_id].rotation
+        return self.model.ee_pose(theta, self.data)[1]
 
     def set_orientation(self, on: bool) -> None:
         """Track the goal orientation or not; switched on, the goal is the present orientation (no jump)."""
@@ -260,17 +241,14 @@ class ResolvedRate(SmoothedTarget):
         if self.orienting:
             self.idle = False
 
-    def _projector(self, q: np.ndarray) -> np.ndarray:
-        """P_RNS at q, from S H_bm."""
-        return rns_projector(pin.crba(self.model.pin_model, self.data, q)[self.model.selected, self.model.m :])
+    def _projector(self, theta: np.ndarray) -> np.ndarray:
+        """P_RNS at theta, from S H_bm."""
+        return rns_projector(self.model.coupling_at(theta, self.data))
 
     def _sigma_at(self, theta: np.ndarray) -> float:
         """The distance to singularity of J-bar at theta (m/rad)."""
-        pm, data, m = self.model.pin_model, self.data, self.model.m
-        q = np.concatenate([np.zeros(m), theta])
-        J_world = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3, m:]
-        J = (data.oMi[self.model.base_joint_id].rotation.T @ J_world)[self.rows]
-        return self._inverse(J @ self._projector(q)).sigma_min
+        J = self.model.ee_frame_jacobian(theta, self.data).linear[self.rows]
+        return self._inverse(J @ self._projector(theta)).sigma_min
 
     def _toward_fold(self, thetadot: np.ndarray) -> bool:
         """Close to a singular curve of J-bar (sigma_min below ``stop_sigma``) and ``thetadot`` goes closer."""
@@ -297,12 +275,7 @@ class ResolvedRate(SmoothedTarget):
         return N @ (truncated_inverse(J_o @ N, self.orient_dof, self.threshold).inverse @ (w - J_o @ thetadot_p))
 
     def ee(self, theta: np.ndarray) -> np.ndarray:
-        pm, data, m = self.model.pin_model, self.data, self.model.m
-        q = np.concatenate([np.zeros(m), theta])
-        pin.forwardKinematics(pm, data, q)
-        pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
-        base = data.oMi[self.model.base_joint_id]
-        return (base.rotation.T @ (data.oMf[self.model.ee_frame_id].translation - base.translation))[self.rows]
+        return self.model.ee_position(theta, self.data)[self.rows]
 
     def step(self, dt: float) -> None:
         """Commit the last integration step, then set (theta', x, x', x'') at the new theta_ref.
@@ -318,21 +291,15 @@ class ResolvedRate(SmoothedTarget):
             return
         f = self.follower
         at_goal = f.step(self.goal, dt, tol=1e-6)
-        pm, data, m = self.model.pin_model, self.data, self.model.m
-        q = np.concatenate([np.zeros(m), self.theta])
-        J_six = pin.computeFrameJacobian(pm, data, q, self.model.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:, m:]
-        J_world = J_six[:3]
-        pin.updateFramePlacement(pm, data, self.model.ee_frame_id)
-        base = data.oMi[self.model.base_joint_id]
-        J = (base.rotation.T @ J_world)[self.rows]
-        x = (base.rotation.T @ (data.oMf[self.model.ee_frame_id].translation - base.translation))[self.rows]
+        frame = self.model.ee_frame_jacobian(self.theta, self.data)
+        J, x = frame.linear[self.rows], frame.position[self.rows]
         gap = f.x - x
         gap_norm = float(np.sqrt(gap @ gap))
         if gap_norm > self.leash:  # the reference is held up (a singular curve of J-bar): wait for it
             f.x = x + gap * (self.leash / gap_norm)
             f.v = np.zeros_like(f.v)
             at_goal = False
-        P = self._projector(q)
+        P = self._projector(self.theta)
         J_bar = J @ P
         rank = min(len(self.rows), self.model.n - len(self.model.selected))
         svd = np.linalg.svd(J_bar, full_matrices=False) if self.orienting else None  # one SVD for both tasks
@@ -344,8 +311,7 @@ class ResolvedRate(SmoothedTarget):
             thetadot *= self.joint_speed / speed
         self.theta_dot_o = self._still
         if self.orienting:  # orthogonal to the primary part: it gets the joint speed the position leaves
-            R = base.rotation.T @ data.oMf[self.model.ee_frame_id].rotation
-            th_o = self.orientation_rate(svd[2][:rank], P, base.rotation.T @ J_six[3:], R, thetadot)  # type: ignore[index]
+            th_o = self.orientation_rate(svd[2][:rank], P, frame.angular, frame.rotation, thetadot)  # type: ignore[index]
             room = float(np.sqrt(max(0.0, self.joint_speed**2 - float(thetadot @ thetadot))))
             speed_o = float(np.sqrt(th_o @ th_o))
             self.theta_dot_o = th_o * (room / speed_o) if speed_o > room else th_o

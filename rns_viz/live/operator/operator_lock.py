@@ -29,8 +29,13 @@ class LockRefused(ValueError):
 
 
 class OperatorLock:
-    def __init__(self, password: str | None = None, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self, password: str | None = None, clock: Callable[[], float] = time.monotonic, seat_on_connect: bool = True
+    ) -> None:
+        """``seat_on_connect=False`` (a server open to the network): nobody operates by connecting or by
+        being left over; the seat goes to the first client that asks for it (:meth:`take`)."""
         self.password = password
+        self.seat_on_connect = seat_on_connect
         self._clock = clock
         self._lock = threading.Lock()
         self._clients: list[int] = []  # in order of arrival
@@ -42,6 +47,12 @@ class OperatorLock:
         self.version = 0  # bumps whenever the operator or the set of clients changes
 
     def _eligible(self, client: int) -> bool:
+        """May ``client`` get the seat without asking (on connect, or as the heir of a leaving operator)?"""
+        if not self.seat_on_connect:
+            return False
+        return self._may_hold(client)
+
+    def _may_hold(self, client: int) -> bool:
         return self.password is None or client in self._authed or self._browser.get(client) in self._authed_browsers
 
     def _keeping(self) -> bool:
@@ -132,7 +143,7 @@ class OperatorLock:
         with self._lock:
             if client not in self._clients:
                 raise LockRefused("that client is not connected")
-            if not self._eligible(client):
+            if not self._may_hold(client):
                 raise LockRefused("enter the session password to take control")
             self._kept = None
             if self.operator != client:
@@ -147,7 +158,7 @@ class OperatorLock:
     def may_operate(self, client: int) -> bool:
         """``client`` may hold the lock (no password is set, or it or its browser gave it)."""
         with self._lock:
-            return self._eligible(client)
+            return self._may_hold(client)
 
     def browser(self, client: int) -> str | None:
         """The token of ``client``'s browser, once identified."""

@@ -30,6 +30,10 @@ class SmoothedTarget:
         """The task coordinates of the end effector at ``theta`` (m)."""
         raise NotImplementedError
 
+    def step(self, dt: float) -> None:
+        """Move the smoothed target (and theta) on by ``dt`` s; sets ``idle`` once at the goal."""
+        raise NotImplementedError
+
     def reset(self, theta: np.ndarray, keep_goal: bool = False) -> None:
         """Stand still at ``theta``: the smoothed target on the end effector, at rest; the goal kept if asked
         (then the target moves on towards it)."""

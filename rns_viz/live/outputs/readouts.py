@@ -6,7 +6,8 @@ from functools import cache
 
 import numpy as np
 
-from rns_viz.live.operator.dual_arm import compensator_sigmas, is_dual
+from rns_viz.live.operator.dual_arm import compensator_sigmas
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.published.snapshot import Readouts
 from rns_viz.model import FsmsModel
 from rns_viz.rns import null_vector, rns_projector, singularity_distance, truncated_inverse
@@ -16,10 +17,9 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
     """S H_bm, its distance to singularity (kg m, rns.singularity_distance), the RNS-rank-th singular value
     of J-bar and the RNS dimension
     (dual arms: the compensator's sigma_min(W S H_bm,2) and the task arm's sigma_min(J_1) instead)."""
-    if is_dual(model):
+    if operator_class(model).compensates:
         return compensator_sigmas(model, theta)
-    m = model.m
-    H = model.mass_matrix(model.q(theta))[model.selected, m:]
+    H = model.coupling_at(theta)
     rns_dim = model.n - H.shape[0]
     # the (n - r)-th singular value when the RNS has fewer directions than task rows: the truncation the
     # reference and Eq. (24) invert with (rns.truncated_inverse), so every readout of sigma(J-bar) agrees
@@ -31,7 +31,7 @@ def _sigmas(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, float, flo
 def null_motion(model: FsmsModel, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For a 1-D RNS at theta: n (kg m, Eq. 27) and the end-effector velocity J n it makes (3-vector,
     base frame, m/s per unit u-bar), the arrow the teaching view draws."""
-    n = null_vector(model.coupling_matrix(model.q(theta)))
+    n = model.null_vector(theta)
     jn = np.zeros(3)
     jn[model.task_rows] = model.ee_jacobian(theta) @ n
     return n, jn
@@ -68,5 +68,5 @@ def compute_readouts(
         ee_error=ee_error,
         reaction=reaction,
         reaction_t=reaction_t,
-        dual=is_dual(model),
+        dual=operator_class(model).compensates,
     )

@@ -15,13 +15,13 @@ import numpy as np
 
 from rns_viz.control import ControlOutput
 from rns_viz.live.operator.dual_arm import compensation_state, operated_is_better
-from rns_viz.live.outputs.reaction import ReactionProbe
 from rns_viz.live.outputs.readouts import compute_readouts
 from rns_viz.live.outputs.recorder import Recorder
 from rns_viz.live.published.plot_buffers import BASE_COORDINATES, PlotBuffers
 from rns_viz.live.published.snapshot import Readouts
 from rns_viz.live.runs.run_pair import RunPair
 from rns_viz.model import FsmsModel
+from rns_viz.sim.reaction import ReactionProbe
 
 PLOT_EVERY = 20  # steps between plot samples (50 Hz: a 10 s window is 500 samples)
 READOUT_EVERY = 50  # steps between readout updates (20 Hz)

@@ -6,6 +6,8 @@ import threading
 
 import numpy as np
 
+from rns_viz.sim.ring import Ring
+
 # "suppress" is 1.0 while the operated run had suppression on (the shadow had it off), else 0.0.
 # xb is the base deflection (mm): x_b itself on a 1-DOF base, |translation| on a larger one, whose
 # coordinates are xb_1 ... xb_6 (mm or mrad, the operated run; 0 beyond the base's m).
@@ -26,28 +28,22 @@ class PlotBuffers:
     """``capacity`` rows of PLOT_SERIES; the loop appends, any thread copies a time-ordered view."""
 
     def __init__(self, capacity: int = 1000) -> None:
-        self._data = np.full((capacity, len(PLOT_SERIES)), np.nan)
-        self._next = 0
-        self._count = 0
+        self._ring = Ring(capacity, len(PLOT_SERIES))
         self._lock = threading.Lock()
         self.version = 0
 
     def clear(self) -> None:
         with self._lock:
-            self._next = self._count = 0
+            self._ring.clear()
             self.version += 1
 
     def append(self, row: tuple[float, ...]) -> None:
         with self._lock:
-            self._data[self._next] = row
-            self._next = (self._next + 1) % len(self._data)
-            self._count = min(self._count + 1, len(self._data))
+            self._ring.append(row)
             self.version += 1
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Each series, oldest first (copies)."""
         with self._lock:
-            k = self._count
-            idx = (self._next - k + np.arange(k)) % len(self._data)
-            rows = self._data[idx]
+            rows = self._ring.newest()
         return {name: rows[:, i].copy() for i, name in enumerate(PLOT_SERIES)}

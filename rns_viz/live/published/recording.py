@@ -11,17 +11,16 @@ suppression was on.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
+from rns_viz.csvio import csv_text
 from rns_viz.live.published.plot_buffers import PLOT_SERIES
 from rns_viz.model import FsmsModel
-from rns_viz.sim.log import write_csv_rows
+from rns_viz.sim.log import base_units
 
 PLOT_WINDOW_S = 10.0  # s: the live plots' window, replayed alike
 PLOT_EVERY = 20  # steps between replayed plot samples (50 Hz, as live)
@@ -34,38 +33,9 @@ def reaction_columns(m: int) -> tuple[str, ...]:
     return ("reaction",) if m == 1 else tuple(f"reaction_{i + 1}" for i in range(m))
 
 
-_UNITS = {
-    "t": "s",
-    "xbdot": "m/s",
-    "xb": "m",
-    "thetadot": "rad/s",
-    "theta_ref": "rad",
-    "theta": "rad",
-    "tau": "N m",
-    "fext": "N",
-    "ee": "m",
-    "L": "kg m/s",
-    "sigma_hbm": "kg m",
-    "sigma_jbar": "m/rad",
-    "reaction": "N",
-    "suppress": "1 = on",
-}
-
-
-def column_unit(name: str, rotational_base: bool = False) -> str:
-    """The unit of a recording or step-log column (``shadow_`` columns like their run's)."""
-    name = name.removeprefix("shadow_")
-    for prefix, unit in _UNITS.items():  # longest prefixes first where they share a start
-        if name == prefix or name.startswith(prefix + "_"):
-            if rotational_base and prefix in ("xb", "xbdot", "fext", "reaction"):
-                return {"xb": "rad", "xbdot": "rad/s", "fext": "N m", "reaction": "N m"}[prefix]
-            return unit
-    return ""
-
-
-def split_header(cell: str) -> str:
-    """``"xb_1 (m)"`` -> ``"xb_1"``."""
-    return cell.split(" (", 1)[0].strip()
+def reaction_units(model: FsmsModel) -> tuple[str, ...]:
+    """The units of :func:`reaction_columns`: a force (N) on a translation, a moment (N m) on a rotation."""
+    return tuple(u.force for u in base_units(model))
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,6 +44,7 @@ class Recording:
     step from there. Read-only; ``model`` is the loop's model instance (kinematics only, own data)."""
 
     columns: tuple[str, ...]
+    units: tuple[str, ...]  # of each column (the step log's, rns_viz.sim.log.log_units)
     data: np.ndarray  # (steps, columns), float64, read-only
     model: FsmsModel = field(repr=False)
     dt: float  # s
@@ -198,16 +169,6 @@ class Recording:
                 ref[a] = self.data[k, self.index[col]]
         return float(np.linalg.norm(ref - x))
 
-    # ---------------------------------------------------------------- CSV
-    def header(self) -> list[str]:
-        return [f"{name} ({column_unit(name, self._rotational(name))})" for name in self.columns]
-
-    def _rotational(self, name: str) -> bool:
-        """A base column about a rotation (its base row's joint is revolute; a row-less name: the first row's)."""
-        row = name.rpartition("_")[2]
-        i = int(row) - 1 if row.isdigit() and 0 < int(row) <= self.model.m else 0
-        return self.model.base_rotational[i]
-
     def wrench(self, k: int) -> tuple[float, ...]:
         """The recorded reaction's base rows at step k (N, N m); () before the first evaluation."""
         w = self.data[k, self._reaction]
@@ -218,18 +179,8 @@ class Recording:
         return np.array([self.index[name] for name in reaction_columns(self.model.m)], dtype=int)
 
     def csv(self) -> bytes:
-        """Every step as CSV: a header with units, 17 significant digits (reads back bit-exact)."""
-        with io.StringIO(newline="") as text:
-            write_csv_rows(text, self.header(), self.table, digits=17)
-            return text.getvalue().encode()
-
-
-def read_csv(data: bytes) -> tuple[list[str], np.ndarray]:
-    """Column names (units stripped) and rows of a recording's or step log's CSV."""
-    reader = csv.reader(io.StringIO(data.decode()))
-    header = [split_header(cell) for cell in next(reader)]
-    rows = np.array([[float(x) for x in row] for row in reader if row], dtype=float)
-    return header, rows.reshape(-1, len(header))
+        """Every step as CSV (rns_viz.csvio): units in the header, 17 significant digits (reads back bit-exact)."""
+        return csv_text(self.columns, self.units, self.table).encode()
 
 
 def _plotted(columns: np.ndarray) -> np.ndarray:

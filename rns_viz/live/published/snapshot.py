@@ -14,6 +14,7 @@ import numpy as np
 from rns_viz.control import Gains, LawKind
 from rns_viz.defaults import defaults_for
 from rns_viz.live.published.recording import Recording
+from rns_viz.model import FsmsModel
 
 Level = Literal["info", "warning", "error"]
 UBAR_SPEED = 30.0  # 1/(kg m s): default u-bar of scrubbing, drags and cyclic motion (Fig. 12's value)
@@ -43,11 +44,12 @@ class Settings:
     preset: str | None
 
     @classmethod
-    def defaults(cls, model: str, shadow: bool, speed: float) -> Settings:
-        """A model's defaults (rns_viz.defaults), suppression on, no preset."""
-        law = defaults_for(model).law
-        gains = defaults_for(model).gains_for(law)
-        return cls(model, law, gains, True, UBAR_SPEED, defaults_for(model).target_speed_m_s, shadow, speed, None)
+    def defaults(cls, model: FsmsModel, shadow: bool, speed: float) -> Settings:
+        """A loaded model's defaults (rns_viz.defaults: its [app] table), suppression on, no preset."""
+        defaults = defaults_for(model)
+        law = defaults.law
+        gains = defaults.gains_for(law)
+        return cls(model.name, law, gains, True, UBAR_SPEED, defaults.target_speed_m_s, shadow, speed, None)
 
 
 @dataclass(frozen=True)
@@ -92,6 +94,7 @@ class LessonStatus:
     task: str
     done: bool
     progress: str  # what is measured now
+    look: str = ""  # what to watch on screen
 
 
 @dataclass(frozen=True)

@@ -1,2 +1,2 @@
-"""Where the arm can go without moving the base: the current reactionless path as a table over its path
-integral (1-D RNS), the reactionless-reachable set (otherwise) and the arm's reach."""
+"""Where a target may go: the reactionless reachable set (the library's, :mod:`rns_viz.paths`) as the operator's
+region, the inside test and clamping to it, and the arm's reach."""

@@ -2,7 +2,8 @@
 
 A translating base (the planar 3R) is explored on the level set of its coupling potential
 (:func:`rns_viz.paths.reactionless_reachable_set`); a base that turns (boom7 with r <= 4) by integrating
-the RNS distribution (:mod:`rns_viz.live.reach.spatial`), which also says whether it is involutive.
+the RNS distribution (:func:`rns_viz.paths.explore_rns`), with the Lie-bracket test of whether it is
+involutive (:func:`rns_viz.integrability.bracket_rank`).
 """
 
 from __future__ import annotations
@@ -11,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rns_viz.live.reach.spatial import bracket_rank, explore_rns
+from rns_viz.integrability import bracket_rank
 from rns_viz.model import FsmsModel
-from rns_viz.paths import CouplingField, reactionless_reachable_set
+from rns_viz.paths import CouplingField, explore_rns, reactionless_reachable_set
 
 
 def arm_reach(model: FsmsModel) -> float:
@@ -66,7 +67,7 @@ def build_reach_region(model: FsmsModel, theta: np.ndarray, spacing: float = 0.1
     if not model.base_is_translational:
         voxel = arm_reach(model) / VOXELS_PER_REACH
         found = explore_rns(model, theta, voxel)
-        rank = bracket_rank(lambda th: model.coupling_matrix(model.q(th)), theta)
+        rank = bracket_rank(model.coupling_at, theta)
         nan = np.full(len(model.selected), np.nan)
         dims, rns_dim = len(model.task_rows), model.n - len(model.selected)
         return ReachRegion(found.points, found.thetas, voxel, nan, dims, rank.words(), rns_dim < dims)

@@ -31,7 +31,8 @@ from rns_viz.control import (
     TrackJointReference,
     VelocityLaw,
 )
-from rns_viz.live.operator.dual_arm import dual_law, is_dual
+from rns_viz.live.operator.dual_arm import dual_law
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.model import FsmsModel
 
 LAW_LABELS: dict[LawKind, str] = {
@@ -68,7 +69,7 @@ def build_law(
     A dual-arm model (:mod:`rns_viz.live.operator.dual_arm`) runs the compensating law whatever ``kind`` (the
     operator's law choice is refused there), its compensator held still in the ``shadow`` run.
     """
-    if is_dual(model):
+    if operator_class(model).compensates:
         return LiveLaw(dual_law(model, gains, suppress, task, shadow), follows_task=True)
     if joint_move and kind != "velocity":
         return LiveLaw(JointServo(model, gains, joint), follows_task=False)

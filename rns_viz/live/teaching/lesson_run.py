@@ -7,17 +7,24 @@ import math
 from rns_viz.live.operator.operator import Operator
 from rns_viz.live.published.snapshot import LessonStatus
 from rns_viz.live.runs.run_pair import RunPair
-from rns_viz.live.teaching.lessons import LESSONS, Check, Lesson, RunView
+from rns_viz.live.teaching.lessons import Check, Lesson, RunView, lessons_for
 from rns_viz.model import FsmsModel
+from rns_viz.params import model_source
 
 OBSERVE_EVERY = 10  # steps between observations (10 ms)
 
 
 class LessonRun:
     def __init__(self, model: str, number: int) -> None:
-        self.model, self.number = model, number
-        self.lesson: Lesson = LESSONS[model][number - 1]
+        self.model, self.number = model, number  # the model offering the lesson, and where in its list
+        self.count = len(lessons := lessons_for(model))
+        self.lesson: Lesson = lessons[number - 1]
         self.check: Check | None = None  # made on the first observation, with the loop's model
+
+    @property
+    def home(self) -> str:
+        """The model the lesson runs on (its start's, without the selection)."""
+        return model_source(self.lesson.start.model)
 
     def observe(self, model: FsmsModel, view: RunView) -> None:
         if self.check is None:
@@ -30,11 +37,12 @@ class LessonRun:
         return LessonStatus(
             model=self.model,
             number=self.number,
-            count=len(LESSONS[self.model]),
+            count=self.count,
             title=lesson.title,
             equation=lesson.equation,
             text=lesson.text,
             task=lesson.task,
+            look=lesson.look,
             done=progress.done if progress is not None else False,
             progress=progress.message if progress is not None else "",
         )

@@ -96,9 +96,11 @@ class LessonStart:
 
 @dataclass(frozen=True)
 class Lesson:
+    name: str  # what a parameter file's [app] lessons calls it
     title: str
     equation: str  # the paper's equation(s) it is about
     text: str  # one or two sentences of explanation
     task: str  # what the student does
     start: LessonStart
     check: Callable[[FsmsModel], Check]
+    look: str = ""  # what to watch on screen while doing the task (plain words)

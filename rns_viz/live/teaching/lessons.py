@@ -5,7 +5,8 @@ A :class:`Lesson` says what it is about (a sentence or two and the paper's equat
 from the simulation: a :class:`Check` observes the run every few steps and says when the task is
 done. Checks start afresh when the run restarts (reset, model switch). Nothing here imports viser.
 A control the student is to use is named in *italics* exactly as the panel labels it (a test checks
-every name against the app's controls).
+every name against the app's controls). Every lesson has a name; a model's parameter file lists the
+lessons it offers, in teaching order (``[app] lessons``).
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ import numpy as np
 
 from rns_viz.live.teaching.lesson_types import Check, Envelope, Lesson, LessonStart, Progress, RunView
 from rns_viz.live.teaching.lessons_boom import BOOM7_LESSONS
+from rns_viz.param_file import ModelFileError, unknown
+from rns_viz.params import MODEL_NAMES, param_file_for, source_path
 from rns_viz.scenarios import FIG11_SLOW_S
 
 
@@ -213,26 +216,31 @@ class AbsorbKick(Check):
 
 TREP_LESSONS = (
     Lesson(
+        "trep-spring",
         "The base is a spring",
         "Eq. (1)",
         "TREP (a two-link arm on a flexible beam) has its arm bolted to the beam's tip: that tip is the **base**. "
         "It moves like a mass on a spring (Eq. (1), the equation of motion), pushed by outside forces and "
         "by the arm's own motion. With the joints held, nothing damps it. Its bend x_b is drawn enlarged "
-        "(x10 by default).",
+        "(the factor is written beside the base).",
         "Press *Kick the base* (a push in newtons, N) and watch the red line in *Live plots*: the base's bend "
         "x_b. The blue line is the shadow run, a copy with suppression on: ignore it until lesson 4.",
         LessonStart("trep", "velocity", False),
         KickAndSwing,
+        look="the red line of the base vibration plot: the swing after a kick does not die out.",
     ),
     Lesson(
+        "trep-pushing-motion",
         "A motion that pushes",
         "Eq. (8): L = H_bm θ'",
         "Every joint motion carries coupling momentum L = H_bm θ' into the base, unless it is reactionless.",
         "Press *Same end points, joint space*: joint 2 turns alone by half a turn. Watch the base.",
         LessonStart("trep", "velocity", True),
         ShakesTheBase,
+        look="the bent plates and the base vibration plot while joint 2 turns.",
     ),
     Lesson(
+        "trep-reactionless-path",
         "The reactionless path",
         "Eqs. (27), (30): θ' = n ū",
         "Moving along n, the null-space vector of H_bm, keeps L = 0: the base feels nothing. ū (1/(kg m s)) "
@@ -241,8 +249,10 @@ TREP_LESSONS = (
         "the other side with the base deflection below 0.1 mm.",
         LessonStart("trep", "velocity", True),
         StaysStill,
+        look="the base vibration plot: it stays flat while the arm moves across.",
     ),
     Lesson(
+        "trep-suppression",
         "Vibration suppression",
         "Eq. (30): θ'_cmd = H_bm⁺ m_b g_b x_b + g_m (θ_ref − θ)",
         "The arm damps the base by a motion outside the reaction null space, proportional to the deflection. "
@@ -250,8 +260,10 @@ TREP_LESSONS = (
         "Press *Kick the base* and compare the arm with its shadow.",
         LessonStart("trep", "velocity", True),
         SuppressedVersusShadow,
+        look="the arm against its blue ghost, and the blue line against the red one in the base vibration plot.",
     ),
     Lesson(
+        "trep-weakest-point",
         "Where suppression is weakest",
         "Eq. (30): H_bm⁺",
         "The smaller the distance to singularity σ_min(W S H_bm), the faster the joints must turn for the same "
@@ -259,8 +271,10 @@ TREP_LESSONS = (
         "Move along the path to where σ_min(W S H_bm) (readout) is at most 65 % of its start value, and stop there.",
         LessonStart("trep", "velocity", True),
         WeakestPoint,
+        look="the distance to singularity in the readouts, and how fast the joints turn as it shrinks.",
     ),
     Lesson(
+        "trep-move-and-suppress",
         "Moving and suppressing at once",
         "Fig. 12",
         "Reactionless motion and vibration suppression add up: the first never reaches the base, the "
@@ -268,11 +282,13 @@ TREP_LESSONS = (
         "Press *Start cyclic motion* (the arm goes round the path), then *Kick the base*.",
         LessonStart("trep", "velocity", True),
         CyclicAndKick,
+        look="the base vibration plot: the kick's swing dies out while the arm keeps going round.",
     ),
 )
 
 PLANAR3R_LESSONS = (
     Lesson(
+        "3r-tracking",
         "Reactionless end-point tracking",
         "Eq. (24)",
         "Three joints, one base direction: a two-dimensional reaction null space, enough to move the end "
@@ -280,8 +296,10 @@ PLANAR3R_LESSONS = (
         "Drag the target 20 cm or more; the base must stay below 0.1 mm.",
         LessonStart("planar3r", "acceleration", True),
         TrackWithoutReaction,
+        look="the base vibration plot (near zero) while the hand follows the handle.",
     ),
     Lesson(
+        "3r-reachable-set",
         "The reactionless-reachable set",
         "Sec. V",
         "Without reaction the arm's centre of mass cannot move along the base direction, so only part of "
@@ -289,8 +307,10 @@ PLANAR3R_LESSONS = (
         "Drag the target far outside the lilac dots and watch where the arm goes and where it stops.",
         LessonStart("planar3r", "acceleration", True),
         ClampedTarget,
+        look="where the hand stops: on the edge of the lilac dots, not at the handle.",
     ),
     Lesson(
+        "3r-absorb-kick",
         "Absorbing a kick",
         "Eq. (15)",
         "Law (15) damps the base by moving the arm's centre of mass; the end effector keeps its target, so "
@@ -298,9 +318,28 @@ PLANAR3R_LESSONS = (
         "Press *Kick the base* (2 N or more) and watch the arm absorb it.",
         LessonStart("planar3r", "acceleration", True),
         AbsorbKick,
+        look="the elbow swinging while the hand holds its place, and the base vibration dying out.",
     ),
 )
 
-__all__ = ["LESSONS", "Check", "Lesson", "LessonStart", "Progress", "RunView"]
+__all__ = ["LESSON_LIBRARY", "Check", "Lesson", "LessonStart", "Progress", "RunView", "lessons_for"]
 
-LESSONS: dict[str, tuple[Lesson, ...]] = {"trep": TREP_LESSONS, "planar3r": PLANAR3R_LESSONS, "boom7": BOOM7_LESSONS}
+# Every lesson by name; a model offers some of them, in its own order ([app] lessons of its parameter file).
+LESSON_LIBRARY: dict[str, Lesson] = {
+    lesson.name: lesson for lesson in (*TREP_LESSONS, *PLANAR3R_LESSONS, *BOOM7_LESSONS)
+}
+
+
+def lessons_for(key: str) -> tuple[Lesson, ...]:
+    """The lessons a model offers (a bundled name or a parameter file), numbered from 1 in this order; each
+    starts the model it was written for. ModelFileError (a ValueError) for a name no lesson has."""
+    names = param_file_for(key).app.lessons
+    for name in names:
+        if name not in LESSON_LIBRARY:
+            raise ModelFileError(f"{source_path(key)}: [app] lessons: {unknown(name, list(LESSON_LIBRARY), 'lesson')}")
+    return tuple(LESSON_LIBRARY[name] for name in names)
+
+
+def models_with_lessons() -> tuple[str, ...]:
+    """The bundled models that offer lessons."""
+    return tuple(name for name in MODEL_NAMES if param_file_for(name).app.lessons)

@@ -62,7 +62,7 @@ class SixModesSuppressed(Check):
         if math.isnan(self.kick_t):
             return Progress(False, f"Waiting for a kick. Tip now {_six(self.now)}.")
         if not self.shadow_on:
-            return Progress(False, "Tick *Shadow run* to compare with suppression off, and kick again.")
+            return Progress(False, "Tick *Ghost run* to compare with suppression off, and kick again.")
         if self.peak[0] <= self.MIN_PEAK_M:
             return Progress(False, f"The shadow's peak is {self.peak[0] * 1e3:.3f} mm: kick harder (5 N or more).")
         share = 100 * self.left / np.maximum(self.peak, 1e-12)
@@ -141,6 +141,7 @@ class ForcesStayZero(Check):
 
 BOOM7_LESSONS = (
     Lesson(
+        "boom7-six-modes",
         "A kick in six directions",
         "Eqs. (13), (15)",
         "boom7: a 7-joint arm on the tip of a 4 m boom. The tip has six elastic coordinates: three "
@@ -150,8 +151,10 @@ BOOM7_LESSONS = (
         "operated boom stops while the shadow rings. Untick *Vibration suppression* to see it the other way.",
         LessonStart("boom7", "acceleration", True),
         SixModesSuppressed,
+        look="the Base coordinates plot: six deflections dying out, while the ghost keeps ringing.",
     ),
     Lesson(
+        "boom7-path",
         "A reactionless path in 3-D",
         "Eqs. (9), (11): θ' = n ū",
         "With all six reactions selected (r = 6) seven joints leave a one-dimensional reaction null space: "
@@ -160,8 +163,10 @@ BOOM7_LESSONS = (
         "below 1 µm and 1 µrad.",
         LessonStart("boom7", "acceleration", True),
         BoomStaysStill,
+        look="the base vibration plot (micrometres) while the hand moves.",
     ),
     Lesson(
+        "boom7-forces-only",
         "Forces only",
         "Sec. III-B: S H_bm",
         "Select only the forces (S = x, y, z): the reaction null space grows to four dimensions, enough to "
@@ -171,5 +176,6 @@ BOOM7_LESSONS = (
         "shake the boom.",
         LessonStart("boom7#S=111000", "acceleration", True),
         ForcesStayZero,
+        look="the momentum handed to the base (L): its force rows stay near zero, the moment rows move.",
     ),
 )

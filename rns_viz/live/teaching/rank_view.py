@@ -1,9 +1,10 @@
 """Rank deficiency of S H_bm as the workspace overlay draws it (Sec. III-B, the fourth case).
 
 :func:`rank_overlay` finds the configurations where S H_bm loses rank (:mod:`rns_viz.rank`) and gives,
-for each, the arm's pose as the polyline base-frame joint positions -> end effector, what the scene
-draws. For one base row (TREP, the 3R) the set is a few isolated poses with every link along the
-deflection axis; the drawn pose is that configuration, so each drawn point carries its sigma_min.
+for each, the arm's pose as the polyline base-frame joint positions -> end effector
+(:meth:`FsmsModel.arm_points`), what the scene draws. For one base row (TREP, the 3R) the set is a few
+isolated poses with every link along the deflection axis; the drawn pose is that configuration, so each
+drawn point carries its sigma_min.
 :func:`rank_inset` gives the same configurations in a plane of two joints, over sigma_min(W S H_bm),
 for the joint-space inset.
 """
@@ -14,9 +15,8 @@ from dataclasses import dataclass
 from functools import cache
 
 import numpy as np
-import pinocchio as pin
 
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.model import FsmsModel
 from rns_viz.rank import rank_deficient_configurations, sigma_grid
 
@@ -40,21 +40,9 @@ class RankOverlay:
     scale: float  # the largest ||S H_bm|| over the search grid (the most coupled direction), kg m
 
 
-def arm_pose(model: FsmsModel, theta: np.ndarray) -> np.ndarray:
-    """Positions of the arm joints and the end effector in the base frame at theta, (n + 1, 3), m."""
-    pm = model.pin_model
-    data = pm.createData()
-    pin.forwardKinematics(pm, data, model.q(theta))
-    pin.updateFramePlacement(pm, data, model.ee_frame_id)
-    base = data.oMi[model.base_joint_id]
-    points = [data.oMi[j].translation for j in range(model.base_joint_id + 1, pm.njoints)]
-    points.append(data.oMf[model.ee_frame_id].translation)
-    return np.array([base.rotation.T @ (p - base.translation) for p in points])
-
-
 def has_rank_inset(model: FsmsModel) -> bool:
     """The model has a rank-loss overlay and inset: one arm of 2 or 3 joints."""
-    return not is_dual(model) and model.n in SEEDS_PER_JOINT
+    return not operator_class(model).compensates and model.n in SEEDS_PER_JOINT
 
 
 @cache
@@ -65,12 +53,12 @@ def rank_overlay(key: str) -> RankOverlay | None:
     if not has_rank_inset(model):
         return None
     loss = rank_deficient_configurations(model, points_per_joint=SEEDS_PER_JOINT[model.n])
-    poses = np.array([arm_pose(model, t) for t in loss.theta]).reshape(-1, model.n + 1, 3)
+    poses = np.array([model.arm_points(t) for t in loss.theta]).reshape(-1, model.n + 1, 3)
     return RankOverlay(loss.theta, poses, loss.sigma_min, loss.scale)
 
 
 INSET_SLICE_STEP = np.deg2rad(5.0)  # rad: the 3R's slice follows theta_1 in steps of this
-INSET_POINTS = {2: 61, 3: 41}  # grid nodes per axis of the sigma_min field (one-off ~50 ms, a slice ~6 ms)
+INSET_POINTS = {2: 61, 3: 41}  # grid nodes per axis of the sigma_min field (the 3R's is recomputed per slice)
 
 
 @dataclass(frozen=True)

@@ -23,10 +23,11 @@ BROWSER_ASK_S = 30.0  # s: how long a page may take to answer (it answers after 
 class Connections:
     """The clients of one server: notifications, operator rights and the per-client panels."""
 
-    def __init__(self, server: viser.ViserServer, password: str | None) -> None:
+    def __init__(self, server: viser.ViserServer, password: str | None, seat_on_connect: bool = True) -> None:
+        """``seat_on_connect=False``: a visitor operates only after pressing Take control (OperatorLock)."""
         self.server = server
         self.password = password
-        self.lock = OperatorLock(password)
+        self.lock = OperatorLock(password, seat_on_connect=seat_on_connect)
         self.panels = OperatorPanels(self.lock, self.notify)
 
     def recipients(self, client: viser.ClientHandle | None) -> list[viser.ClientHandle]:

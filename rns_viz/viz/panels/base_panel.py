@@ -108,7 +108,7 @@ class BasePanel:
         names = coordinate_names(model)
         with self.controls.quiet():
             self.direction.options = (*(n.split(" ")[0] for n in names), ALL)
-        axis = defaults_for(model.name).kick_axis if default_axis is None else default_axis  # the gain map's kick
+        axis = defaults_for(model).kick_axis if default_axis is None else default_axis  # the gain map's kick
         self.controls.show(self.direction, self.direction.options[min(axis, model.m - 1)])
         for i, box in enumerate(self.boxes):
             box.visible = i < model.m

@@ -18,24 +18,20 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.runs.laws import LAW_LABELS
-from rns_viz.params import model_source
-from rns_viz.scenarios import DUAL_SCENARIOS, FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, PANDA_SCENARIOS
+from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, presets_for
+from rns_viz.viz.panels.glossary import glossary_markdown
 from rns_viz.viz.panels.live_plots import LivePlots
 from rns_viz.viz.panels.model_menu import ModelMenu
 from rns_viz.viz.panels.number_field import NumberField, hide_slider_boxes
 
+PLOTS_WIDTH_PX = 360  # the docked plots' width: a 1366 px screen keeps ~600 px of scene between the panels
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
-TREP_PRESETS = ("fig10-on", "fig10-off", "fig11-slow", "fig11-fast", "fig11-joint2", "fig12-on", "fig12-off")
-PLANAR3R_PRESETS = ("fig3", "fig4")
-BOOM7_PRESETS = ("boom7-kick-on", "boom7-kick-off", "boom7-path", "boom7-track", "boom7-p2p")
-PANDA_PRESETS = tuple(PANDA_SCENARIOS)  # the same five on the Panda; shown instead while boom-panda is served
-DUAL_PRESETS = tuple(DUAL_SCENARIOS)  # trep2: the task arm's circle and a kick, compensator on and off
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     (
         "g_b",
-        "g_b (1/s)",
+        "Base damping g_b (1/s)",
         0.0,
         50.0,
         0.1,
@@ -43,7 +39,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "g_m",
-        "g_m (1/s)",
+        "Joint hold g_m (1/s)",
         0.0,
         100.0,
         0.1,
@@ -52,7 +48,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "G_p",
-        "G_p (1/s²)",
+        "Hand pull G_p (1/s²)",
         0.0,
         2000.0,
         1.0,
@@ -60,7 +56,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "G_d",
-        "G_d (1/s)",
+        "Hand damping G_d (1/s)",
         0.0,
         500.0,
         1.0,
@@ -68,7 +64,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "k_p",
-        "k_p (1/s²)",
+        "Joint stiffness k_p (1/s²)",
         0.0,
         2000.0,
         1.0,
@@ -76,7 +72,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "k_d",
-        "k_d (1/s)",
+        "Joint damping k_d (1/s)",
         0.0,
         200.0,
         0.5,
@@ -90,6 +86,7 @@ class GuiElements:
     """Handles of everything in the panel (the app reads and wires them; tests find them here)."""
 
     status: viser.GuiHtmlHandle
+    frame_robot: viser.GuiButtonHandle
     kick: viser.GuiButtonHandle
     kick_peak: NumberField
     suppression: viser.GuiCheckboxHandle
@@ -99,6 +96,7 @@ class GuiElements:
     speed: viser.GuiDropdownHandle
     readouts: viser.GuiHtmlHandle
     plots: LivePlots
+    plots_panel: viser.PanelHandle
     path_folder: viser.GuiFolderHandle
     sigma: NumberField
     play_slow: viser.GuiButtonHandle
@@ -109,18 +107,16 @@ class GuiElements:
     target_folder: viser.GuiFolderHandle
     target_text: viser.GuiMarkdownHandle
     target_speed: NumberField
+    gains_folder: viser.GuiFolderHandle
     law: viser.GuiDropdownHandle
     gains: dict[str, NumberField]
-    presets_trep: viser.GuiButtonGroupHandle
-    presets_3r: viser.GuiButtonGroupHandle
-    presets_dual: viser.GuiButtonGroupHandle
-    presets_boom7: viser.GuiButtonGroupHandle
-    presets_panda: viser.GuiButtonGroupHandle
+    presets: dict[str, viser.GuiButtonGroupHandle]  # model key -> its presets, in the menu's order
     preset_paused: viser.GuiCheckboxHandle
     preset_info: viser.GuiMarkdownHandle
     model: viser.GuiDropdownHandle
     menu: ModelMenu
     exaggeration: NumberField
+    auto_exaggeration: viser.GuiCheckboxHandle
     shadow: viser.GuiCheckboxHandle
     download: viser.GuiButtonHandle
 
@@ -143,11 +139,26 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     """Build the panel for ``model`` (its kick range and exaggeration; ``menu``: the models offered, by
     default the bundled ones); the app wires the callbacks."""
     menu = menu or ModelMenu((model,))
+    defaults = defaults_for(model)
     gui = server.gui
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
     gui.main_panel.dock_right()
     hide_slider_boxes(gui)  # every slider's value is shown and typed in its NumberField's box
+    # The live plots in their own panel, docked left of the scene: in view beside the robot whatever the
+    # main panel is scrolled to (on a phone: a section of viser's bottom sheet, collapsed at first).
+    plots_panel = gui.add_panel(order=0.0)
+    with plots_panel.add_tab("Live plots (last 10 s)", viser.Icon.CHART_LINE):
+        plots = LivePlots(gui)
+    with plots_panel.add_tab("Help: words and keys", viser.Icon.HELP):
+        gui.add_markdown(glossary_markdown())
+    plots_panel.dock_left()
+    plots_panel.set_width(PLOTS_WIDTH_PX)
     status = gui.add_html("")
+    frame_robot = gui.add_button(
+        "Frame robot",
+        icon=viser.Icon.FOCUS_CENTERED,
+        hint="Your camera back on the robot, framed for your screen (key F). Moves only your own view.",
+    )
     gui.add_markdown(
         "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
         "drag the handle labelled **drag me** in the scene (its arrows or its square)."
@@ -161,11 +172,11 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         kick_peak = NumberField(
             gui,
-            "Kick peak (N)",
-            min=-defaults_for(model).kick_range_N,
-            max=defaults_for(model).kick_range_N,
+            "Kick strength, peak force (N)",
+            min=-defaults.kick_range_N,
+            max=defaults.kick_range_N,
             step=0.1,
-            initial_value=defaults_for(model).kick_peak_N,
+            initial_value=defaults.kick_peak_N,
             hint="Peak of the half-sine force pulse on the base (N); the app says more per model.",
             bounded=True,  # read at the next kick
         )
@@ -184,21 +195,19 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "Reset", icon=viser.Icon.REFRESH, hint="Back to the start (of the preset, if one is loaded)."
         )
     with gui.add_folder("Paper presets"):
-        presets_trep = gui.add_button_group("TREP", TREP_PRESETS, hint=preset_hint(TREP_PRESETS))
-        presets_3r = gui.add_button_group("Planar 3R", PLANAR3R_PRESETS, hint=preset_hint(PLANAR3R_PRESETS))
-        presets_dual = gui.add_button_group("TREP + compensator", DUAL_PRESETS, hint=preset_hint(DUAL_PRESETS))
-        presets_boom7 = gui.add_button_group("Boom (3-D)", BOOM7_PRESETS, hint=preset_hint(BOOM7_PRESETS))
-        presets_panda = gui.add_button_group(
-            "Panda on the boom", PANDA_PRESETS, hint=preset_hint(PANDA_PRESETS), visible=False
-        )
+        presets = {}
+        for key in menu.keys.values():  # each model's presets ([app] presets), under its heading
+            names = presets_for(key)
+            if names:
+                heading = menu.presets_heading(key)
+                presets[key] = gui.add_button_group(heading, names, hint=preset_hint(names))
+        show_presets(presets, menu, model)
         preset_paused = gui.add_checkbox(
             "Start paused",
             True,
             hint="A preset waits at t = 0 for Resume, so its kick and motion happen with the plots in view.",
         )
         preset_info = gui.add_markdown("")
-    with gui.add_folder("Live plots (last 10 s)"):
-        plots = LivePlots(gui)
     with gui.add_folder("Readouts"):
         readouts = gui.add_html("")
     with gui.add_folder("Reactionless path") as path_folder:
@@ -208,7 +217,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         sigma = NumberField(
             gui,
-            "Path ∫ū dt (1/(kg·m))",
+            "Position along the path ∫ū dt (1/(kg·m))",
             min=-80.0,
             max=80.0,
             step=0.1,
@@ -240,7 +249,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         )
         ubar_speed = NumberField(
             gui,
-            "ū speed (1/(kg·m·s))",
+            "Speed along the path ū (1/(kg·m·s))",
             min=1.0,
             max=100.0,
             step=1.0,
@@ -261,7 +270,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="Speed limit of the smoothed target.",
             bounded=False,
         )
-    with gui.add_folder("Control law and gains", expand_by_default=False):
+    with gui.add_folder("Control law and gains", expand_by_default=False) as gains_folder:
         law = gui.add_dropdown(
             "Law",
             tuple(LAW_LABELS[k] for k in LAW_KINDS),
@@ -278,19 +287,25 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             "Model",
             menu.labels,
             initial_value=menu.label(model),
-            hint="TREP: the paper's 2-joint arm on a bending beam. Planar 3R: a 3-joint arm on a cart on a spring. "
-            "TREP with a compensating arm: a second arm on the beam tip cancels the first one's reaction. The "
-            "7-DOF arm on a flexible boom: a spatial system, six base coordinates. Files: given with --model.",
+            hint="The bundled models (each labelled by its parameter file) and the files given with --model "
+            "(rns-viz serve --model FILE.toml).",
         )
         exaggeration = NumberField(
             gui,
-            "Deflection drawn ×",
+            "Base deflection drawn ×",
             min=1.0,
             max=100.0,
             step=1.0,
-            initial_value=defaults_for(model).exaggeration,
-            hint="The base deflection is drawn this many times larger than simulated.",
+            initial_value=defaults.exaggeration,
+            hint="The base deflection is drawn this many times larger than simulated (written beside the base). "
+            "Typing a factor fixes it (Auto off).",
             bounded=True,  # only drawn
+        )
+        auto_exaggeration = gui.add_checkbox(
+            "Auto deflection scale",
+            defaults.auto_exaggeration,
+            hint="The factor follows the motion: the recent largest base deflection is drawn at about a tenth "
+            "of the arm's reach (1-2-5 steps up to ×10000), so µm and mm both show.",
         )
         speed = gui.add_dropdown(
             "Speed",
@@ -299,18 +314,19 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
             hint="Simulated seconds per wall-clock second.",
         )
         shadow = gui.add_checkbox(
-            "Shadow run",
+            "Ghost run (suppression the other way)",
             True,
-            hint="A second simulation with the same inputs and kicks and suppression the other way: "
+            hint="The shadow run: a second simulation with the same inputs and kicks and suppression the other way: "
             "the blue ghost and the second plot lines.",
         )
     download = gui.add_button(
         "Download log (CSV)",
         icon=viser.Icon.DOWNLOAD,
-        hint="The last 20 s of the simulation, one row per 1 ms step, SI units (see README).",
+        hint="The last 20 s of the simulation, one row per 1 ms step, SI units (the documentation lists the columns).",
     )
     return GuiElements(
         status=status,
+        frame_robot=frame_robot,
         kick=kick,
         kick_peak=kick_peak,
         suppression=suppression,
@@ -320,6 +336,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         speed=speed,
         readouts=readouts,
         plots=plots,
+        plots_panel=plots_panel,
         path_folder=path_folder,
         sigma=sigma,
         play_slow=play_slow,
@@ -330,18 +347,16 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         target_folder=target_folder,
         target_text=target_text,
         target_speed=target_speed,
+        gains_folder=gains_folder,
         law=law,
         gains=gains,
-        presets_trep=presets_trep,
-        presets_3r=presets_3r,
-        presets_dual=presets_dual,
-        presets_boom7=presets_boom7,
-        presets_panda=presets_panda,
+        presets=presets,
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
         menu=menu,
         exaggeration=exaggeration,
+        auto_exaggeration=auto_exaggeration,
         shadow=shadow,
         download=download,
     )
@@ -354,13 +369,23 @@ def preset_hint(names: tuple[str, ...]) -> str:
     return f"One click loads a figure's experiment (law, gains, motion, kicks, model). {what}. {units}"
 
 
-def show_boom_presets(g: GuiElements, model_key: str) -> None:
-    """The boom's presets for the arm in view: the Panda's while boom-panda is served, else boom7's."""
-    panda = model_source(model_key) == "boom-panda"
-    g.presets_panda.visible, g.presets_boom7.visible = panda, not panda
+def show_presets(presets: dict[str, viser.GuiButtonGroupHandle], menu: ModelMenu, model_key: str) -> None:
+    """One row of presets per heading: models sharing a heading (boom7 and boom-panda: the same boom) share
+    its row, which shows the served model's presets, else those of the first such model in the menu."""
+    served = menu.source_key(model_key)
+    shown: dict[str, str] = {}  # heading -> the key whose presets it shows
+    for key in presets:
+        heading = menu.presets_heading(key)
+        if heading not in shown or key == served:
+            shown[heading] = key
+    for key, group in presets.items():
+        visible = shown[menu.presets_heading(key)] == key
+        if group.visible != visible:
+            group.visible = visible
 
 
 def preset_description(name: str | None) -> str:
     if name is None:
         return ""
-    return f"**{name}**: {LIVE_SCENARIOS[name].description}. Reset restarts it."
+    preset = LIVE_SCENARIOS[name]
+    return f"**{name}**: {preset.description}.\n\n**Look at:** {preset.look} Reset restarts it."

@@ -1,4 +1,4 @@
-"""The gain explorer in the app (issue 10): panel folder, root loci, and the map in the scene.
+"""The gain explorer in the app: panel folder, root loci, and the map in the scene.
 
 :class:`GainExplorerView` is built once with the panel; the renderer hands it each model's scene
 (:meth:`build_scene`) and calls :meth:`frame` every frame, which redraws only when
@@ -23,6 +23,7 @@ from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.control_panel import GAIN_SLIDERS, GuiElements
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.model_menu import label_of
+from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.gain_scene import GainScene, Quantity
 from rns_viz.viz.scene.style import SceneStyle
 
@@ -55,7 +56,7 @@ def _locus_plot(gui: viser.GuiApi, title: str) -> viser.GuiUplotHandle:
         series=tuple(series),
         title=title,
         scales={"x": {"time": False, "auto": False, "range": (-1.0, 0.1)}, "y": {"auto": False, "range": (-1.0, 1.0)}},
-        axes=({"label": "Re λ (1/s)"}, {"label": "Im λ (1/s)", "size": 60}),
+        axes=({"label": "decay rate Re λ (1/s)"}, {"label": "ringing Im λ (1/s)", "size": 60}),
         legend={"show": True, "live": False},
         cursor={"show": False},
         aspect=1.3,
@@ -86,11 +87,14 @@ class GainExplorerView:
         self.server, self.session, self.gui = server, session, gui
         self.controls, self.connections = controls, connections
         g = server.gui
-        with g.add_folder("Gain explorer", order=gui.download.order - 0.5, expand_by_default=True):  # above Download
+        with g.add_folder(
+            "Gain explorer", order=gui.download.order - 0.5, expand_by_default=True
+        ) as self.folder:  # above Download
             g.add_markdown(
-                "**Gain map** in the scene (left of the robot): each cell is a (g_b, g_m) setting, coloured by "
-                "how fast the closed loop, linearised about the current pose, damps a kick (the one in the map's "
-                "title; faded, hatched cells: it cannot say). **Click a cell** to apply its gains."
+                "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
+                "(g_b, g_m) setting, coloured by how fast the closed loop, linearised about the current pose, damps a "
+                "kick (the one in the map's title; faded, hatched cells: it cannot say). "
+                "**Click a cell** to apply its gains."
             )
             self.quantity = g.add_dropdown(
                 "Map shows",
@@ -118,6 +122,16 @@ class GainExplorerView:
         self._drawn: dict[str, object] = {}
         self._loci_of: tuple[str, str] | None = None  # (model, law) of the root loci drawn
         self._clicked: tuple[float, float] | None = None  # gains of a map click, for the sliders to show
+
+    def show(self, on: bool, robot_scene: FsmsScene) -> None:
+        """Show or hide the map and the authority overlay in the scene (the *Gain map* toggle). Every camera
+        then frames what is shown: the robot, with the map while it is shown (it stands left of the robot,
+        out of a view framed on the robot alone); *Frame robot* does the same."""
+        if self.scene is None or not self.scene.set_shown(on):
+            return
+        robot_scene.frame_also(self.scene.framed_corners() if on else None)
+        if on:
+            self._version, self._drawn, self._next_check = -1, {}, 0.0  # draw the view now
 
     def build_scene(self, style: SceneStyle, on_path: bool) -> None:
         """The model's scene was (re)built: add the map to it."""

@@ -58,6 +58,7 @@ class Controls:
         self.spatial_target = False  # the handle gives (x, y, z), not (x, y): set by the renderer per model
         self.target_lift = np.zeros(3)  # m: the handle is drawn this far above the target (base frame)
         self.pose_target = False  # the handle's orientation is the target's too (set by the renderer)
+        self._button_acts: dict[int, Act] = {}  # id(button) -> what a click does (a key press does the same)
         self._wire()
 
     # ---------------------------------------------------------------- values shown vs. values in force
@@ -118,6 +119,7 @@ class Controls:
             self._apply(handle, event.client, event.target.value, act, check=checked, keep=not button)
 
         if button:
+            self._button_acts[id(handle)] = act
             handle.on_click(callback)
         else:
             self._good[id(handle)] = handle.value
@@ -172,13 +174,24 @@ class Controls:
 
     on_input = _on_input  # for panels built elsewhere (viz/panels/gain_panel.py)
 
+    def press(self, button: viser.GuiButtonHandle, client: viser.ClientHandle | None) -> None:
+        """Do what a click on ``button`` by ``client`` does (a keyboard command): the same session command,
+        refused for a watcher the same way."""
+        self._apply(button, client, None, self._button_acts[id(button)], check=False, keep=False)
+
+    def act(self, handle: Any, client: viser.ClientHandle | None, act: Act) -> None:
+        """Run ``act(None, client_id)`` as ``client``'s input on ``handle`` (refused for a watcher)."""
+        self._apply(handle, client, None, act, check=False, keep=False)
+
     def _wire(self) -> None:
         g, s = self.gui, self.session
         self._on_input(
             g.kick, lambda _, c: s.kick(float(self.good(g.kick_peak)), c, self.kick_direction()), button=True
         )
         self._on_input(g.kick_peak, lambda v, c: None)  # read at the next kick
-        self._on_input(g.exaggeration, lambda v, c: None)  # read by the render thread
+        # read by the render thread; a factor typed or dragged is a fixed one
+        self._on_input(g.exaggeration, lambda v, c: self.show(g.auto_exaggeration, False))
+        self._on_input(g.auto_exaggeration, lambda v, c: None)  # read by the render thread
         self._on_input(g.suppression, lambda v, c: s.set_suppression(bool(v), c))
         self._on_input(g.pause, lambda _, c: self._pause_button(c), button=True)
         self._on_input(g.step, lambda _, c: s.single_step(1, c), button=True)
@@ -195,7 +208,7 @@ class Controls:
         for name, slider in g.gains.items():
             self._on_input(slider, lambda v, c, name=name: s.set_gains(c, **{name: float(v)}))
         self._on_input(g.preset_paused, lambda v, c: None)  # read at the next preset
-        for group in (g.presets_trep, g.presets_3r, g.presets_dual, g.presets_boom7, g.presets_panda):
+        for group in g.presets.values():
             self._on_input(group, lambda v, c: s.load_preset(v, c, bool(self.good(g.preset_paused))), button=True)
         self._on_input(g.plots.scale, lambda v, c: g.plots.show_mode(_SCALE_OF_LABEL[v]))
         self._on_input(g.model, lambda v, c: s.switch_model(g.menu.key_of(v), c))

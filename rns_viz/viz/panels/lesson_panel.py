@@ -9,39 +9,34 @@ them through the session and shows ``snapshot().lesson``. Refreshed by the rende
 from __future__ import annotations
 
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from pathlib import Path
 
 import viser
 
 from rns_viz.live.loop.session import Session
 from rns_viz.live.published.snapshot import LessonStatus, Snapshot
-from rns_viz.live.teaching.lessons import LESSONS
-from rns_viz.params import model_source
+from rns_viz.live.teaching.lessons import lessons_for
+from rns_viz.params import MODEL_NAMES, model_source, param_file_for
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.scene.view_toggles import ViewToggles
 
-MODEL_SHORT = {"trep": "TREP", "planar3r": "3R", "boom7": "boom7"}
-CHOICES: dict[str, tuple[str, int]] = {
-    f"{MODEL_SHORT[model]} {i + 1}. {lesson.title}": (model, i + 1)
-    for model, lessons in LESSONS.items()
-    for i, lesson in enumerate(lessons)
-}
 # What each lesson draws (the rest can be ticked by hand): only what the lesson has explained so far,
-# so lesson 1 shows no ghost (its suppression is lesson 4's subject) and no n (lesson 3's).
-BASICS = ("reaction", "trail")
-LESSON_VIEWS: dict[tuple[str, int], tuple[str, ...]] = {
-    ("trep", 1): BASICS,
-    ("trep", 2): (*BASICS, "coupling"),
-    ("trep", 3): (*BASICS, "coupling", "null_vector", "path_arrows"),
-    ("trep", 4): (*BASICS, "coupling", "ghost"),
-    ("trep", 5): (*BASICS, "coupling", "null_vector", "path_arrows"),
-    ("trep", 6): (*BASICS, "coupling", "null_vector", "path_arrows", "ghost"),
-    ("planar3r", 1): (*BASICS, "coupling", "reach"),
-    ("planar3r", 2): (*BASICS, "reach"),
-    ("planar3r", 3): (*BASICS, "coupling", "reach", "ghost"),
-    ("boom7", 1): (*BASICS, "ghost"),
-    ("boom7", 2): (*BASICS, "coupling", "null_vector", "path_arrows"),
-    ("boom7", 3): (*BASICS, "coupling"),
+# so TREP's first lesson shows no ghost (its suppression is lesson 4's subject) and no n (lesson 3's).
+BASICS = ("reaction", "trail", "labels")
+LESSON_VIEWS: dict[str, tuple[str, ...]] = {
+    "trep-spring": BASICS,
+    "trep-pushing-motion": (*BASICS, "coupling"),
+    "trep-reactionless-path": (*BASICS, "coupling", "null_vector", "path_arrows"),
+    "trep-suppression": (*BASICS, "coupling", "ghost"),
+    "trep-weakest-point": (*BASICS, "coupling", "null_vector", "path_arrows"),
+    "trep-move-and-suppress": (*BASICS, "coupling", "null_vector", "path_arrows", "ghost"),
+    "3r-tracking": (*BASICS, "coupling", "reach"),
+    "3r-reachable-set": (*BASICS, "reach"),
+    "3r-absorb-kick": (*BASICS, "coupling", "reach", "ghost"),
+    "boom7-six-modes": (*BASICS, "ghost"),
+    "boom7-path": (*BASICS, "coupling", "null_vector", "path_arrows"),
+    "boom7-forces-only": (*BASICS, "coupling"),
 }
 NO_LESSON = (
     "No lesson running. Pick one under *Lesson* and press *Start*, or press *Next* for lesson 1. Each lesson "
@@ -50,11 +45,22 @@ NO_LESSON = (
 LAST_DONE = "That was the last lesson of this model: pick another under *Lesson* and press *Start*."
 
 
-def chooser_entry(status: LessonStatus | None, model: str) -> str:
+def lesson_choices(keys: Iterable[str] = MODEL_NAMES) -> dict[str, tuple[str, int]]:
+    """The chooser's entries, ``"TREP 1. The base is a spring"`` -> (model key, lesson number): the lessons of
+    every model in ``keys`` (each model's ``[app] lessons``, its ``[app] short_label`` in front)."""
+    choices = {}
+    for key in keys:
+        short = param_file_for(key).app.short_label or Path(model_source(key)).stem
+        for i, lesson in enumerate(lessons_for(key)):
+            choices[f"{short} {i + 1}. {lesson.title}"] = (key, i + 1)
+    return choices
+
+
+def chooser_entry(status: LessonStatus | None, model: str, choices: dict[str, tuple[str, int]]) -> str:
     """The chooser's entry: the lesson running, else lesson 1 of model ``model`` (a model key), else of the first
     model with lessons."""
     wanted = (status.model, status.number) if status is not None else (model_source(model), 1)
-    return next((k for k, v in CHOICES.items() if v == wanted), next(iter(CHOICES)))
+    return next((k for k, v in choices.items() if v == wanted), next(iter(choices)))
 
 
 def lesson_markdown(status: LessonStatus | None) -> str:
@@ -66,7 +72,8 @@ def lesson_markdown(status: LessonStatus | None) -> str:
     progress = f"**Done.** {then}" if status.done else status.progress
     return (
         f"**Lesson {status.number} of {status.count}: {status.title}**{mark}\n\n"
-        f"*Paper: {status.equation}*\n\n{status.text}\n\n**Task:** {status.task}\n\n{progress}"
+        f"{status.text}\n\n**Task:** {status.task}\n\n**Look at:** {status.look}\n\n{progress}\n\n"
+        f"*In the paper: {status.equation}*"
     )
 
 
@@ -80,8 +87,11 @@ class LessonPanel:
         connections: Connections,
         order: float | None = None,
         view: ViewToggles | None = None,
+        models: Iterable[str] = MODEL_NAMES,
     ) -> None:
         self.session, self.connections, self.view = session, connections, view
+        self.choices = lesson_choices(models)  # of the models in the menu
+        self._names = {v: lessons_for(v[0])[v[1] - 1].name for v in self.choices.values()}  # (model, number) -> name
         gui = server.gui
         with gui.add_folder("Lessons", order=order):
             self.text = gui.add_markdown(NO_LESSON)
@@ -92,7 +102,7 @@ class LessonPanel:
             self.stop = gui.add_button("Stop lesson", icon=viser.Icon.PLAYER_STOP, hint="Leave the lesson mode.")
             self.chooser = gui.add_dropdown(
                 "Lesson",
-                tuple(CHOICES),
+                tuple(self.choices),
                 hint="Every lesson of every model; Start loads the chosen one (and its model).",
             )
             self.start = gui.add_button("Start", icon=viser.Icon.PLAYER_PLAY, hint="Start the lesson chosen above.")
@@ -122,7 +132,9 @@ class LessonPanel:
         snap = self.session.snapshot()
         status = snap.lesson
         if status is None:
-            self.session.start_lesson(snap.settings.model if snap.settings.model in LESSONS else "trep", 1, client)
+            offering = {model for model, _ in self.choices.values()}
+            model = snap.settings.model if snap.settings.model in offering else next(iter(self.choices.values()))[0]
+            self.session.start_lesson(model, 1, client)
             return
         number = status.number + direction
         if 1 <= number <= status.count:
@@ -131,7 +143,7 @@ class LessonPanel:
             raise ValueError("that was the last lesson" if direction > 0 else "this is the first lesson")
 
     def _start_chosen(self, client: int | None) -> None:
-        choice = CHOICES.get(self.chooser.value)
+        choice = self.choices.get(self.chooser.value)
         if choice is None:
             raise ValueError(f"no lesson named {self.chooser.value!r}")
         self.session.start_lesson(*choice, client=client)
@@ -148,11 +160,12 @@ class LessonPanel:
         if now != self._for:  # the chooser follows the lesson started (by any button or the CLI) or the model
             started = self._for is None or shown != self._for[0]
             self._for = now
-            name = chooser_entry(status, snap.settings.model)
+            name = chooser_entry(status, snap.settings.model, self.choices)
             if self.chooser.value != name:
                 self.chooser.value = name
-            if started and shown is not None and self.view is not None and shown in LESSON_VIEWS:
-                self.view.show_only(LESSON_VIEWS[shown])
+            views = LESSON_VIEWS.get(self._names.get(shown, "")) if shown is not None else None
+            if started and self.view is not None and views is not None:
+                self.view.show_only(views)
         _set_disabled(self.previous, status is None or status.number <= 1)
         _set_disabled(self.next, status is not None and status.number >= status.count)
         _set_disabled(self.stop, status is None)

@@ -27,6 +27,8 @@ import viser.uplot
 from rns_viz.viz.panels.units import si
 
 ON_COLOUR, OFF_COLOUR, ERROR_COLOUR = "#1f6fd1", "#e0503a", "#2a9d4b"
+# chart titles: plain words first, the symbol of the axis second
+XB_TITLE, L_TITLE, E_TITLE = "Base vibration x_b", "Momentum handed to the base L", "Hand's miss: error |e|"
 SCALES = {"linear": "linear, fits the data", "symlog": "symmetric log, fixed range"}
 # Display units of the linear charts (name, SI value): one chart per unit, the one shown suits the data.
 LENGTH_UNITS = (("nm", 1e-9), ("µm", 1e-6), ("mm", 1e-3), ("m", 1.0))
@@ -137,11 +139,10 @@ class LivePlots:
     def __init__(self, gui: viser.GuiApi) -> None:
         linear: viser.uplot.Scale = {"auto": True}
         # charts take no hint: their meaning in plain words
-        self.caption = gui.add_html(PLOTS_CAPTION.format(runs=RUNS_SENTENCE["suppression"]))
         # (runs, scale, quantity, unit) -> chart: one per legend (a chart's series names cannot change),
         # scale and display unit (nor can its axis); the error chart's runs and scale are None
         self.chart_set: dict[tuple[str | None, str | None, str, str], viser.GuiUplotHandle] = {}
-        titles = {"xb": ("Base deflection", "x_b"), "L": ("Coupling momentum", "L")}
+        titles = {"xb": (XB_TITLE, "x_b"), "L": (L_TITLE, "L")}
         for runs in RUNS:
             for name, (title, symbol) in titles.items():
                 for unit, _ in UNITS[name]:
@@ -149,16 +150,17 @@ class LivePlots:
                         gui, title, f"{symbol} ({unit})", LEGEND[runs], linear, visible=False
                     )
             self.chart_set[runs, "symlog", "xb", "µm"] = _chart(
-                gui, "Base deflection", "x_b", LEGEND[runs], _symlog(XB_SYMLOG), False, XB_SYMLOG_TICKS
+                gui, XB_TITLE, "x_b", LEGEND[runs], _symlog(XB_SYMLOG), False, XB_SYMLOG_TICKS
             )
             self.chart_set[runs, "symlog", "L", "mN·s"] = _chart(
-                gui, "Coupling momentum", "L", LEGEND[runs], _symlog(L_SYMLOG), False, L_SYMLOG_TICKS
+                gui, L_TITLE, "L", LEGEND[runs], _symlog(L_SYMLOG), False, L_SYMLOG_TICKS
             )
         for unit, _ in LENGTH_UNITS:
             self.chart_set[None, None, "e", unit] = _chart(
-                gui, "End-effector error", f"|e| ({unit})", (("|x_ref − x_e|", ERROR_COLOUR),), linear, False
+                gui, E_TITLE, f"|e| ({unit})", (("|x_ref − x_e|", ERROR_COLOUR),), linear, False
             )
         self.peaks = gui.add_html(peaks_html(None))
+        self.caption = gui.add_html(PLOTS_CAPTION.format(runs=RUNS_SENTENCE["suppression"]))  # below: plots first
         self.scale = gui.add_dropdown(
             "Plot scale",
             tuple(SCALES.values()),
@@ -288,7 +290,7 @@ def _clean(x: np.ndarray) -> np.ndarray:
     return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
 
 
-_ROWS = (("xb", "|x_b|", "m"), ("L", "|L|", "N·s"), ("e", "|e|", "m"))
+_ROWS = (("xb", "base |x_b|", "m"), ("L", "momentum |L|", "N·s"), ("e", "hand miss |e|", "m"))
 _ROW_HINTS = {
     "xb": "largest bend of the base from rest in the last 10 s",
     "L": "largest momentum the joints handed to the base (1 N·s = 1 kg·m/s)",

@@ -7,7 +7,7 @@ Pure functions of the model; the renderer shows them whenever it builds a model'
 from __future__ import annotations
 
 from rns_viz.defaults import defaults_for
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.model import FsmsModel
 
 
@@ -16,7 +16,7 @@ def target_text(model: FsmsModel) -> str:
     followed by a task arm whose reaction a second arm cancels."""
     spatial = len(model.task_rows) == 3
     drag = "Drag the handle labelled **drag me** " + ("in 3-D (x, y and z)" if spatial else "(x and y only)")
-    if is_dual(model):
+    if operator_class(model).compensates:
         return (
             f"{drag}: the task arm follows anywhere in its workspace; the second arm cancels its reaction on the base."
         )
@@ -30,7 +30,7 @@ def target_text(model: FsmsModel) -> str:
 def kick_hint(model: FsmsModel) -> str:
     """The kick slider's hint: the pulse of this model (its duration) and, for a base of several
     coordinates, where its direction is chosen."""
-    duration = defaults_for(model.name).kick_duration_s
+    duration = defaults_for(model).kick_duration_s
     hint = f"Peak of the half-sine force pulse on the base ({duration:g} s long), N"
     if model.m > 1:
         hint += "; along the direction chosen under Base coordinates (N m on a rotation)"

@@ -43,7 +43,7 @@ def status_html(snap: Snapshot) -> str:
     speed = f"{st.speed:g}×"
     return (
         f'<div style="font-size:0.9em;line-height:1.5">{state}{behind} <b>{model}</b>{preset}<br>'
-        f"t = {snap.t:7.2f} s · real-time factor {rtf} (speed {speed})<br>"
+        f"t = {snap.t:7.2f} s · {rtf}× real time (speed {speed})<br>"
         f'<span style="color:#555">arm: {snap.mode}</span></div>'
     )
 
@@ -84,18 +84,22 @@ def readouts_html(snap: Snapshot) -> str:
             "it; kg·m, a turning base's moment rows (kg·m²) divided by the arm's reach",
         ),
         (
-            "σ(J̄)",
+            "hand's freedom σ(J̄)",
             _value(r.sigma_jbar, r.warn_jbar, "m/rad"),
             "how freely the hand can move without pushing the base (J̄ = J P<sub>RNS</sub>)",
         ),
-        ("n", n, "the joint direction that pushes the base not at all (orange arrow: the hand's way), Eq. (27)"),
         (
-            "L = H<sub>bm</sub>θ̇",
+            "reaction-free direction n",
+            n,
+            "the joint direction that pushes the base not at all (orange arrow: the hand's way), Eq. (27)",
+        ),
+        (
+            "momentum handed to the base L = H<sub>bm</sub>θ̇",
             si(r.L, "N·s", 1e-9, True),
             "momentum the joints hand to the base (purple arrow), Eq. (8); 1 N·s = 1 kg·m/s",
         ),
-        ("x<sub>b</sub>", _deflection(snap), "how far the base is bent from rest"),
-        ("end-effector error", err, "how far the hand is from where the law sends it"),
+        ("base vibration x<sub>b</sub>", _deflection(snap), "how far the base is bent from rest"),
+        ("hand's miss |e|", err, "how far the hand is from where the law sends it"),
         (
             "reaction on base",
             si(r.reaction, "N", 1e-6, True),
@@ -129,12 +133,12 @@ def dual_rows(snap: Snapshot) -> list[tuple[str, str, str]]:
         ),
         ("compensator", cancel, "whether the second arm cancels the task arm's reaction on the base"),
         (
-            "σ<sub>min</sub>(J<sub>1</sub>)",
+            "task hand's freedom σ<sub>min</sub>(J<sub>1</sub>)",
             _value(r.sigma_jbar, r.warn_jbar, "m/rad"),
             "how freely the task arm's hand moves; near 0 it is stretched out or folded",
         ),
         (
-            "L = S H<sub>bm</sub>θ̇",
+            "momentum both arms hand over L = S H<sub>bm</sub>θ̇",
             si(r.L, "N·s", 1e-9, True),
             "total momentum both arms hand to the base (purple arrow), Eq. (8): the compensator keeps it 0",
         ),

@@ -50,7 +50,7 @@ class ReplayPanel:
         self._busy = threading.Lock()
         self._shown_version = -1
         gui = server.gui
-        with gui.add_folder("Record and replay", expand_by_default=False):
+        with gui.add_folder("Record and replay", expand_by_default=False) as self.folder:
             self.seconds = NumberField(
                 gui,
                 "Last N seconds (s)",

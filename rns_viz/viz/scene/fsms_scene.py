@@ -19,6 +19,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.paths import ReactionlessPath
 from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.scene.boom_drawing import BoomDrawing
+from rns_viz.viz.scene.framing import DEFAULT_ASPECT, DEFAULT_FOV, CameraPose, band_for, frame_points, framed_points
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.scene.shapes import Trail, path_colours, path_family_segments, polyline_segments
@@ -132,7 +133,9 @@ class FsmsScene:
             thickness=1.5 * st.line_thickness,
             visible=False,
         )
-        self._add_labels()
+        self.base_label = self._add_labels()
+        self.framed = framed_points(model)  # world points the camera frames
+        self.also_framed: np.ndarray | None = None  # more of them while shown (the gain map's corners)
         self.set_initial_camera()
         self.q = model.q(model.spec.default_configuration)
         self.exaggeration = 1.0
@@ -146,8 +149,10 @@ class FsmsScene:
         if q_draw.shape != (self.model.nv,):
             raise ValueError(f"q must be (x_b, theta) with shape ({self.model.nv},), got {q_draw.shape}")
         q_draw[:m] *= exaggeration
-        self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
         with self.server.atomic():
+            if exaggeration != self.exaggeration:  # the factor written is the factor drawn
+                self.base_label.text = base_label(exaggeration)
+            self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
             self.robot.pose(q_draw)
             if isinstance(self.base_drawing, BoomDrawing):
                 self.base_drawing.pose(self.robot.base_placement())
@@ -231,16 +236,39 @@ class FsmsScene:
 
     # -- camera --------------------------------------------------------------------------------
     def set_initial_camera(self, clients: bool = True) -> None:
-        """The model's camera for new clients and Reset View; ``clients`` also moves connected ones."""
-        st = self.style
+        """The framed view for new clients (viser's Reset View); ``clients`` also frames connected ones."""
+        pose = self.camera_pose()
         cam = self.server.initial_camera
-        cam.position = st.camera_position
-        cam.look_at = st.camera_look_at
-        cam.near = 0.005 * float(np.linalg.norm(np.subtract(st.camera_position, st.camera_look_at)))
+        cam.position = pose.position
+        cam.look_at = pose.look_at
+        cam.near = 0.005 * float(np.linalg.norm(pose.position - pose.look_at))
         if clients:
             for client in self.server.get_clients().values():
-                client.camera.position = st.camera_position
-                client.camera.look_at = st.camera_look_at
+                self.frame_client(client)
+
+    def camera_pose(self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, width_px: int = 0) -> CameraPose:
+        """Where a camera of this field of view and aspect sees the robot framed (framing.py), with the
+        points of :meth:`frame_also`."""
+        direction = np.subtract(self.style.camera_position, self.style.camera_look_at)
+        points = self.framed if self.also_framed is None else np.vstack([self.framed, self.also_framed])
+        return frame_points(points, direction, fov, aspect, band=band_for(width_px))
+
+    def frame_also(self, points: np.ndarray | None) -> None:
+        """Frame the world ``points`` (N, 3), m, with the robot from now on (None: the robot alone), and
+        frame every connected camera so."""
+        self.also_framed = None if points is None else np.asarray(points, dtype=float).reshape(-1, 3)
+        self.set_initial_camera(clients=True)
+
+    def frame_client(self, client: viser.ClientHandle) -> None:
+        """Point ``client``'s camera at the robot, framed for its page's size."""
+        cam = client.camera
+        width, height = cam.image_width, cam.image_height
+        aspect = width / height if width > 0 and height > 0 else DEFAULT_ASPECT
+        pose = self.camera_pose(cam.fov, aspect, width)
+        with client.atomic():
+            cam.up_direction = (0.0, 0.0, 1.0)
+            cam.position = pose.position  # (viser moves look_at with the position: it is set after)
+            cam.look_at = pose.look_at
 
     # -- internals -----------------------------------------------------------------------------
     def _trail_point(self) -> np.ndarray:
@@ -257,16 +285,23 @@ class FsmsScene:
         self.trail_node.points = polyline_segments(pts)
         self.trail_node.visible = self.show_trail
 
-    def _add_labels(self) -> None:
+    def _add_labels(self) -> viser.LabelHandle:
+        """The names written in the scene; returns the base's label (it writes the drawn factor)."""
         scene, st = self.server.scene, self.style
-        scene.add_label("/base/label", "base x_b", position=st.base_label, anchor="bottom-center")
+        label = scene.add_label("/base/label", base_label(1.0), position=st.base_label, anchor="bottom-center")
         if isinstance(st.base, DoubleBeamStyle):
             scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
         elif isinstance(st.base, BoomStyle):
             scene.add_label("/boom/label", "clamp", position=(0.0, 0.0, 2.0 * st.base.radius), anchor="bottom-center")
         elif isinstance(st.base, CartSpringStyle):
             middle = 0.5 * (st.base.wall_x + st.base.attach[0])
-            scene.add_label("/spring/label", "k_b", position=(middle, 0.0, 0.05))
+            scene.add_label("/spring/label", "spring k_b", position=(middle, 0.0, 0.05))
+        return label
+
+
+def base_label(exaggeration: float) -> str:
+    """The base's label: what it is, and how much larger than simulated its deflection is drawn."""
+    return f"base vibration x_b (drawn ×{exaggeration:g})"
 
 
 def _make_base_drawing(

@@ -1,4 +1,4 @@
-"""The gain map and the authority colours in the 3-D scene (issue 10), so a click applies gains.
+"""The gain map and the authority colours in the 3-D scene, so a click applies gains.
 
 The map is an image standing beside the robot, facing the model's initial camera: g_b (1/s, log)
 to the right, g_m (1/s, log) upwards, each grid cell coloured by a decay rate (1/s, log colour
@@ -38,6 +38,7 @@ NOW_COLOUR = (255, 255, 255)
 # the outline shows only as a frame around the map.
 IMAGE_TURN = tuple(vtf.SO3.from_x_radians(math.pi).wxyz)
 PAPER_COLOUR = (20, 20, 20)
+LABEL_ROOM = 0.15  # x the map's side: the title above it, the legend below, the tick labels left of it
 # viridis at 0, 1/4, 1/2, 3/4, 1 (slow decay dark, fast decay yellow)
 _ANCHORS = np.array([[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]], dtype=float)
 
@@ -171,6 +172,7 @@ class GainScene:
         self.legend = scene.add_label(
             f"{self.FRAME}/legend", "", position=(-0.5 * self.size, -0.5 * self.size - 5 * mark, 0.0), anchor="top-left"
         )
+        self.shown = False  # the Gain map toggle: the map and the authority overlay are drawn only while on
         self._ticks: list[object] = []
         self._paper: list[object] = []
         self._paper_key: tuple[tuple[str, float, float], ...] | None = None
@@ -218,7 +220,25 @@ class GainScene:
             self.show_now(view)
             self.title.text = _title(view, quantity)
             self.legend.text = _legend(quantity, self.scale)
-            self.frame.visible = True
+            self.frame.visible = self.shown
+
+    def set_shown(self, on: bool) -> bool:
+        """Draw the map (once computed) or hide it and the authority overlay; True if that changed (the
+        overlay is then drawn again by :meth:`show_authority`)."""
+        if on == self.shown:
+            return False
+        self.shown = on
+        with self.server.atomic():
+            self.frame.visible = on and self.gain_map is not None
+            if not on:
+                self.authority.visible = self.authority_lines.visible = False
+        return True
+
+    def framed_corners(self) -> np.ndarray:
+        """World corners (4, 3), m, of the map with room for its title, legend and axis ticks around it."""
+        half = 0.5 * self.size + LABEL_ROOM * self.size
+        local = np.array([[x, y, 0.0] for x in (-half, half) for y in (-half, half)])
+        return self.centre + local @ self.rotation.T
 
     def show_now(self, view: GainView) -> None:
         """The white marker at the gains in force (hidden outside the map's range)."""
@@ -309,7 +329,7 @@ class GainScene:
         """Colour the current path (TREP) or the reachable-set points (3R) by the predicted base decay
         rate (1/s) on the base mode map's colour scale; returns the colours drawn (K, 3) or None."""
         pts, auth = view.path_points, view.authority
-        if pts is None or auth is None or len(pts) != len(auth.base_decay_rate) or len(pts) < 2:
+        if not self.shown or pts is None or auth is None or len(pts) != len(auth.base_decay_rate) or len(pts) < 2:
             self.authority.visible = self.authority_lines.visible = False
             return None
         rates = np.asarray(auth.base_decay_rate, dtype=float)

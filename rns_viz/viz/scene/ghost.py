@@ -50,8 +50,15 @@ class Ghost:
         assert root is not None
         self.root = root
         self.base_drawing = _ghost_base(server, model, style.base)
-        # On the ghost's last joint: the label moves with the ghost, clear of the base's own label.
-        self.label = server.scene.add_label(f"{self.robot.node_names[-1]}/ghost_label", "shadow run", anchor="top-left")
+        # At the ghost's hand (the end-effector frame on its joint's node), below and right of it: it moves with
+        # the ghost and stays off the arm's links, which all lie on the other side of the hand.
+        hand = model.pin_model.frames[model.ee_frame_id]
+        self.label = server.scene.add_label(
+            f"{self.robot.node_names[hand.parentJoint]}/ghost_label",
+            "ghost",
+            anchor="top-left",
+            position=tuple(float(v) for v in hand.placement.translation),
+        )
         self.q: np.ndarray | None = None  # the shadow's q as drawn (before exaggeration)
         self.exaggeration = float("nan")
         self.root.visible = False

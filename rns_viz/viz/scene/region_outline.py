@@ -10,16 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
+from scipy.spatial import cKDTree
 
 CELLS = 60  # grid cells across the region's longer side (at least)
 
 
 def sample_spacing(xy: np.ndarray) -> float:
-    """Median nearest-neighbour distance of (up to 400 of) the points, m."""
+    """Median distance from (up to 400 of) the points to their nearest other point, m (coincident points
+    count once; a k-d tree, not the 400 x N distance matrix, which took 0.2 s for the 3R's 6580 samples)."""
     sample = xy[:: max(1, len(xy) // 400)]
-    d = np.sqrt(((sample[:, None, :] - xy[None, :, :]) ** 2).sum(axis=2))
-    d[d == 0.0] = np.inf
-    return float(np.median(d.min(axis=1)))
+    distance, _ = cKDTree(np.unique(xy, axis=0)).query(sample, k=2)  # itself, then its nearest other point
+    return float(np.median(distance[:, 1]))
 
 
 def outline_points(points: np.ndarray, cell: float | None = None) -> np.ndarray:

@@ -1,19 +1,18 @@
 """How each model is drawn: base drawing, camera, grid and marker sizes (metres, metres per newton).
 
-One frozen dataclass per model; :func:`style_for` picks the bundled model's style or derives one
-from the arm's reach for any other URDF.
+One frozen dataclass per model; :func:`style_for` builds it from the model's parameter file (``[app.scene]``),
+deriving what the file leaves out from the arm's reach.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
-from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
-from rns_viz.params import model_source
+from rns_viz.param_file import BaseDrawing, BoomDrawing, CartSpringDrawing, DoubleBeamDrawing, NoDrawing, SceneTable
 
 Vec3 = tuple[float, float, float]
 
@@ -79,72 +78,59 @@ class SceneStyle:
 
 
 def style_for(model: FsmsModel) -> SceneStyle:
-    """The drawing style of a bundled model, or one scaled by the arm's reach."""
-    if model.name in ("trep", "trep2"):
-        trep = SceneStyle(
-            base=DoubleBeamStyle(),
-            camera_position=(0.29, 0.47, 0.48),
-            camera_look_at=(0.0, 0.45, -0.03),
-            grid_z=-0.075,
-            grid_size=3.0,
-            grid_cell=0.05,
-            marker_radius=0.008,
-            line_thickness=0.003,
-            force_scale=0.25,
-            force_arrow_max=0.15,
-            force_origin=(0.065, -0.01, 0.035),  # above the drawn paths
-            trail_capacity=150,
-            trail_jump=0.1,
-            overlay_z=0.024,
-            base_label=(-0.065, -0.01, 0.0),
-        )
-        if model.name == "trep":
-            return trep
-        # trep2: TREP's beam and arm; its compensating arm hangs 0.09 m below the arm plane
-        return replace(trep, grid_z=-0.17, camera_position=(0.24, 0.84, 0.1), camera_look_at=(0.0, 0.42, -0.07))
-    if model.name == "planar3r":
-        return SceneStyle(
-            base=CartSpringStyle(),
-            camera_position=(1.0, -3.3, 3.2),
-            camera_look_at=(1.0, -0.3, -0.25),
-            grid_z=-0.26,
-            grid_size=24.0,
-            grid_cell=0.5,
-            marker_radius=0.07,
-            line_thickness=0.025,
-            force_scale=0.01,
-            force_arrow_max=1.5,
-            force_origin=(0.3, -0.25, -0.05),
-            trail_jump=1.5,
-            base_label=(-0.22, 0.1, 0.0),
-        )
-    if model_source(model.name) in ("boom7", "boom-panda"):  # the same boom, arm and view
-        return SceneStyle(
-            base=BoomStyle(),
-            camera_position=(5.4, -1.7, 1.25),
-            camera_look_at=(3.95, 0.0, 0.35),
-            grid_z=-0.6,
-            grid_size=12.0,
-            grid_cell=0.25,
-            marker_radius=0.025,
-            line_thickness=0.006,
-            force_scale=0.05,
-            force_arrow_max=0.6,
-            force_origin=(0.0, 0.0, -0.2),
-            trail_jump=0.3,
-            base_label=(0.0, -0.25, -0.1),
-        )
-    reach = arm_reach(model)
+    """The drawing style of a model: its parameter file's ``[app.scene]``, any length left out scaled by the
+    arm's reach (rns_viz.param_file.SceneTable)."""
+    scene = model.spec.app.scene
+    reach = model.arm_reach
+    given = {
+        name: value
+        for name, value in ((_FIELD[key], getattr(scene, key)) for key in scene.__struct_fields__ if key in _FIELD)
+        if value is not None
+    }
     return SceneStyle(
-        base=BoomStyle(radius=0.03 * reach) if model.m == 6 and not model.base_is_translational else None,
-        camera_position=(0.8 * reach, -1.6 * reach, 1.8 * reach),
-        camera_look_at=(0.0, 0.0, 0.0),
-        grid_z=-0.1 * reach,
-        grid_size=4.0 * reach,
-        grid_cell=reach / 8,
-        marker_radius=0.04 * reach,
-        line_thickness=0.012 * reach,
-        force_scale=0.1 * reach,
-        force_arrow_max=0.6 * reach,
-        trail_jump=0.5 * reach,
+        **{
+            "base": _base_drawing(model, scene.base, reach),
+            "camera_position": (0.8 * reach, -1.6 * reach, 1.8 * reach),
+            "camera_look_at": (0.0, 0.0, 0.0),
+            "grid_z": -0.1 * reach,
+            "grid_size": 4.0 * reach,
+            "grid_cell": reach / 8,
+            "marker_radius": 0.04 * reach,
+            "line_thickness": 0.012 * reach,
+            "force_scale": 0.1 * reach,
+            "force_arrow_max": 0.6 * reach,
+            "trail_jump": 0.5 * reach,
+            **given,
+        }
     )
+
+
+def _base_drawing(model: FsmsModel, drawing: BaseDrawing | None, reach: float) -> BaseStyle | None:
+    """The base's drawing: the kind the file names with its dimensions (unit suffix dropped), or by default a
+    tube for a base of six coordinates that turns."""
+    if drawing is None:
+        return BoomStyle(radius=0.03 * reach) if model.m == 6 and not model.base_is_translational else None
+    kind = _BASE_KINDS[type(drawing)]
+    if kind is None:
+        return None
+    dimensions = {_unitless(key): getattr(drawing, key) for key in drawing.__struct_fields__}
+    return kind(**{key: value for key, value in dimensions.items() if value is not None})
+
+
+def _unitless(key: str) -> str:
+    """A parameter file's key without its unit: ``camera_position_m`` -> ``camera_position``."""
+    for unit in ("_m_per_N", "_m"):
+        if key.endswith(unit):
+            return key.removesuffix(unit)
+    return key
+
+
+BaseStyle = DoubleBeamStyle | CartSpringStyle | BoomStyle
+_BASE_KINDS: dict[type, type[BaseStyle] | None] = {
+    DoubleBeamDrawing: DoubleBeamStyle,
+    CartSpringDrawing: CartSpringStyle,
+    BoomDrawing: BoomStyle,
+    NoDrawing: None,
+}
+# [app.scene] keys -> SceneStyle fields (the exaggeration and the base are not lengths of the scene style)
+_FIELD = {key: _unitless(key) for key in SceneTable.__struct_fields__ if key not in ("exaggeration", "base", "shown")}

@@ -100,8 +100,8 @@ class TeachScene:
 
     def _shadow_label(self, snap: Snapshot) -> str:
         if snap.readouts.dual:
-            return f"shadow run: compensator {'held' if snap.readouts.compensating else 'cancelling'}"
-        return f"shadow run: suppression {'OFF' if snap.settings.suppress else 'ON'}"
+            return f"ghost: compensator {'held' if snap.readouts.compensating else 'cancelling'}"
+        return f"ghost: suppression {'off' if snap.settings.suppress else 'on'}"  # the panel's *Ghost run*
 
     def _apply_toggles(self, snap: Snapshot, view: ViewToggles) -> None:
         """The scene's own drawings that have a checkbox: reaction arrow, trail, reachable set."""

@@ -11,11 +11,34 @@ from dataclasses import dataclass, field
 
 import viser
 
+from rns_viz.defaults import defaults_for
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.teaching.rank_view import RANK_HINT
+from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
 TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
+    (
+        "labels",
+        "Labels (names in the scene)",
+        True,
+        "The names written in the scene: base, clamp, spring, 'drag me', the ghost's.",
+    ),
+    (
+        "paths",
+        "Other reactionless paths (grey)",
+        False,
+        "The family of reactionless paths around the current one (red, always drawn): every way the hand can "
+        "move without pushing the base, from other start poses.",
+    ),
+    (
+        "gain_map",
+        "Gain map (which gains damp fastest)",
+        False,
+        "A map of (g_b, g_m) settings coloured by how fast the base's swing dies out, left of the robot; click a "
+        "cell to apply its gains. The Gain explorer folder explains it.",
+    ),
     (
         "ghost",
         "Ghost: the shadow run",
@@ -31,14 +54,14 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
     ),
     (
         "coupling",
-        "Coupling momentum L (kg·m/s)",
+        "Momentum handed to the base L (kg·m/s)",
         True,
         "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8). "
         "Zero on a reactionless path.",
     ),
     (
         "null_vector",
-        "Null-space direction n (m/s per unit ū)",
+        "Reaction-free direction n (m/s per unit ū)",
         True,
         "Orange arrow at the hand: where the hand goes when the joints turn along n, the one direction "
         "that pushes the base not at all (Eq. 27); its length is J n, m/s per unit of ū.",
@@ -78,6 +101,12 @@ class ViewToggles:
         box = self.boxes.get(name)
         return True if box is None else box.value is True
 
+    def show(self, name: str, on: bool = True) -> None:
+        """Tick or untick one toggle, as the server (the map for a gain lesson, a test)."""
+        self.good[name] = on
+        if name in self.boxes and self.boxes[name].value != on:
+            self.boxes[name].value = on
+
     def show_only(self, names: Iterable[str]) -> None:
         """Tick exactly ``names`` (a lesson's view), as the server: no refusal, no callback work."""
         wanted = set(names)
@@ -87,10 +116,23 @@ class ViewToggles:
                 box.value = self.good[name]
 
 
-def make_view_toggles(server: viser.ViserServer, connections: Connections) -> ViewToggles:
-    """The folder; a watcher's change (or a value that is not a bool) is set back and reported."""
-    with server.gui.add_folder("Show in the scene", expand_by_default=False):
-        boxes = {name: server.gui.add_checkbox(label, initial, hint=hint) for name, label, initial, hint in TOGGLES}
+def first_look(model: FsmsModel) -> frozenset[str]:
+    """What ``model``'s scene shows at first: its parameter file's ``[app.scene] shown``, and the
+    reactionless-reachable set whenever the operator drives a target over it (a selection S that leaves a
+    reaction null space of two or more dimensions): where the target can go is what the operator needs."""
+    shown = defaults_for(model).shown
+    return (shown | {"reach"}) if operator_class(model).shows == "reachable set" else shown
+
+
+def make_view_toggles(gui: viser.GuiApi, connections: Connections, shown: Iterable[str] | None = None) -> ViewToggles:
+    """The folder, ticked as ``shown`` (the model's defaults; None: each toggle's own initial value); a
+    watcher's change (or a value that is not a bool) is set back and reported."""
+    on = None if shown is None else set(shown)
+    with gui.add_folder("Show in the scene", expand_by_default=False):
+        boxes = {
+            name: gui.add_checkbox(label, initial if on is None else name in on, hint=hint)
+            for name, label, initial, hint in TOGGLES
+        }
     good = {name: box.value for name, box in boxes.items()}
 
     def wire(name: str, box: viser.GuiCheckboxHandle) -> None:

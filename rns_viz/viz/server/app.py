@@ -18,15 +18,19 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
 import viser
 
 from rns_viz.live.loop.session import Session
 from rns_viz.live.operator.operator_lock import OperatorLock
+from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.panels import presentation
 from rns_viz.viz.panels.base_panel import BasePanel
 from rns_viz.viz.panels.control_panel import GuiElements, make_gui
 from rns_viz.viz.panels.inputs import Controls
+from rns_viz.viz.panels.keys import add_key_commands, jog_step
 from rns_viz.viz.panels.lesson_panel import LessonPanel
 from rns_viz.viz.panels.model_menu import ModelMenu
 from rns_viz.viz.panels.path_words import PathWords
@@ -34,10 +38,13 @@ from rns_viz.viz.panels.pictures import Pictures
 from rns_viz.viz.panels.rank_inset import RankInsetPanel
 from rns_viz.viz.panels.replay_panel import ReplayPanel
 from rns_viz.viz.scene.fsms_scene import FsmsScene
-from rns_viz.viz.scene.view_toggles import make_view_toggles
+from rns_viz.viz.scene.view_toggles import first_look, make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
 from rns_viz.viz.server.render import TARGET_HANDLE, Renderer
 
+# Served only to this machine, the first page to connect is the presenter's and operates at once; served to
+# the network (e.g. --host 0.0.0.0), a phone that connects first must not: the seat waits for Take control.
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 IDLE_RESTART_S = 60.0  # s of simulated time: a session nobody watched this long restarts for its first visitor
 
 
@@ -51,20 +58,30 @@ class RnsApp:
         password: str | None = None,
         models: Sequence[str] = (),
         pace: bool = True,
+        seat_on_connect: bool = True,
+        pause_unwatched: bool = False,
+        present: bool = False,
     ) -> None:
-        """``models``: parameter files offered in the model dropdown besides the bundled models;
-        ``pace=False``: every page gets every update however slowly it draws."""
+        """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
+        presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files
+        offered in the model dropdown besides the bundled models;
+        ``pace=False``: every page gets every update however slowly it draws; ``pause_unwatched``: the
+        simulation pauses while no page is open and runs on when one comes (one student's app: its CPU
+        is then ~2 % of a core, not ~12 %); ``present``: the projector's screen
+        (rns_viz.viz.panels.presentation)."""
         self.server = server
         self.session = session
         self.password = password
-        self.connections = Connections(server, password)
+        self.connections = Connections(server, password, seat_on_connect)
         model = session.snapshot().settings.model
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
         self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
-        self.view = make_view_toggles(server, self.connections)
+        self.view = make_view_toggles(server.gui, self.connections, first_look(session.state.model))
         self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
-        self.lessons = LessonPanel(server, session, self.connections, self.gui.status.order + 0.5, self.view)
+        self.lessons = LessonPanel(
+            server, session, self.connections, self.gui.status.order + 0.5, self.view, self.gui.menu.keys.values()
+        )
         self.renderer = Renderer(
             server, session, self.gui, self.controls, self.connections, self.view, base_panel=self.base_panel
         )
@@ -75,9 +92,20 @@ class RnsApp:
         self.renderer.text_panels += [self.replay.refresh, self.rank_inset.refresh]
         # each page gets updates at the rate it can draw; told so under the status line when slowed
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
+        self.keys = add_key_commands(server.gui, self.gui, self.controls, session, self.frame_robot, self._jog_setup)
+        self.gui.frame_robot.on_click(lambda event: self.frame_robot(event.client))
+        self.present_style: viser.GuiHtmlHandle | None = None  # the projector's text size (--present)
+        if present:
+            g = self.gui
+            hidden = (self.renderer.explorer.folder, self.replay.folder, g.gains_folder, g.download)
+            self.present_style = presentation.present(server.gui, g.plots_panel, hidden)
         start = session.snapshot()
         self._unwatched_since: tuple[int, float] | None = (start.epoch, start.t)  # (epoch, t) the last client left
         self._visitors = threading.Lock()
+        self.pause_unwatched = pause_unwatched
+        self._paused_unwatched = pause_unwatched  # paused while no page is open (the next page resumes it)
+        if pause_unwatched:
+            session.pause()
         server.on_client_connect(self._client_joined)
         server.on_client_disconnect(self._client_left)
 
@@ -120,6 +148,18 @@ class RnsApp:
     def render_thread(self) -> threading.Thread:
         return self.renderer.thread
 
+    def frame_robot(self, client: viser.ClientHandle | None) -> None:
+        """Point ``client``'s camera at the robot (every client's for the server's own call, None)."""
+        if client is None:
+            self.scene.set_initial_camera(clients=True)
+        else:
+            self.scene.frame_client(client)
+
+    def _jog_setup(self) -> tuple[np.ndarray, float, bool]:
+        """For a jog key: the target now (base frame, m), the step (m), whether it is spatial."""
+        snap = self.session.snapshot()
+        return self.renderer.home(snap), jog_step(arm_reach(self.model)), self.controls.spatial_target
+
     def good(self, handle: Any) -> Any:
         """The last good value of a GUI control (what the app acts on)."""
         return self.controls.good(handle)
@@ -140,6 +180,14 @@ class RnsApp:
         back after a moment) keeps the simulation, its recording and, for the operator's page, control."""
         self.connections.client_joined(client)
         self.pace.client_joined(client)
+        framed = threading.Event()
+
+        @client.camera.on_update
+        def _(_: viser.CameraHandle) -> None:  # the page's first camera message tells its size: frame for it
+            if not framed.is_set() and client.camera.image_width > 0:
+                framed.set()
+                self.scene.frame_client(client)
+
         with self._visitors:
             since, self._unwatched_since = self._unwatched_since, None
             if since is not None:  # nobody watched since then (a reload's page arrives while the old one is here)
@@ -147,6 +195,9 @@ class RnsApp:
                 unwatched = snap.t - since[1] if snap.epoch == since[0] else snap.t  # s of simulated time
                 if unwatched > IDLE_RESTART_S:
                     self.session.reset()
+            if self._paused_unwatched:
+                self._paused_unwatched = False
+                self.session.resume()
         self.connections.identify_browser(client)  # last: it waits for the page's answer
 
     def _client_left(self, client: viser.ClientHandle) -> None:
@@ -159,6 +210,9 @@ class RnsApp:
             if self.connections.client_count() == 0:
                 snap = self.session.snapshot()
                 self._unwatched_since = (snap.epoch, snap.t)
+                if self.pause_unwatched and not snap.paused:
+                    self._paused_unwatched = True
+                    self.session.pause()
 
 
 def start_app(
@@ -171,26 +225,37 @@ def start_app(
     lesson: int | None = None,
     models: Sequence[str] = (),
     pace: bool = True,
+    pause_unwatched: bool = False,
+    present: bool = False,
 ) -> RnsApp:
     """Start server, session and render thread; returns at once. ``port=0`` picks a free port;
     ``lesson``: start at that lesson (1-based) of the model; ``model`` is a bundled name or a parameter
     file (ModelFileError names the element at fault), ``models`` more files for the model dropdown;
     ``pace=False``: every page gets every update however slowly it draws (for comparisons; see
-    :mod:`rns_viz.viz.server.page_pacing`)."""
+    :mod:`rns_viz.viz.server.page_pacing`); ``pause_unwatched``: see :class:`RnsApp`; ``present``:
+    larger text and fewer folders, for a projector."""
     session = Session(model, realtime=realtime)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
-        app = RnsApp(server, session, password, models, pace=pace).start()
+        app = RnsApp(
+            server,
+            session,
+            password,
+            models,
+            pace=pace,
+            seat_on_connect=host in LOOPBACK_HOSTS,
+            pause_unwatched=pause_unwatched,
+            present=present,
+        ).start()
         if lesson is not None:
             session.start_lesson(model, lesson)
     except Exception:
         session.stop()
         server.stop()
         raise
-    # The long-lived objects built so far (models, meshes, scene, GUI) leave the collector's reach:
-    # a full collection then holds the interpreter lock, and so the simulation, ~4x shorter (measured
-    # 167 -> 42 ms with 8 clients connecting and leaving).
+    # The long-lived objects built so far (models, meshes, scene, GUI) leave the collector's reach, so
+    # a full collection holds the interpreter lock, and with it the simulation, for far less time.
     gc.collect()
     gc.freeze()
     return app
@@ -203,9 +268,13 @@ def serve(
     password: str | None = None,
     lesson: int | None = None,
     models: Sequence[str] = (),
+    pause_unwatched: bool = False,
+    present: bool = False,
 ) -> None:
     """Serve the live app until interrupted (Ctrl+C). Binds 127.0.0.1 unless told otherwise."""
-    app = start_app(model, host, port, password, lesson=lesson, models=models)
+    app = start_app(
+        model, host, port, password, lesson=lesson, models=models, pause_unwatched=pause_unwatched, present=present
+    )
     print(f"rns_viz live app: http://{host}:{app.port}  (Ctrl+C to stop)")
     try:
         while True:

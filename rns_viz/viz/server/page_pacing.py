@@ -252,12 +252,26 @@ def touches_scene(window: Sequence[Any]) -> bool:
 def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float], sent: Callable[[int], None]) -> bool:
     """Make each client's reader of the broadcast buffer wait ``wait_s(client, s since its last
     window)`` before taking its next window, and call ``sent(client)`` for each window it takes that
-    touches the 3-D scene. False (with a warning) if this viser has no such buffer."""
+    touches the 3-D scene. False (with a warning) if this viser has no such buffer. A one-client view
+    (:class:`~rns_viz.viz.clients.client_view.ClientView`) paces that client's own stream instead."""
+    attach = getattr(server, "attach_pace_gate", None)
+    if attach is not None:
+        return bool(attach(wait_s, sent))
     try:
         buffer = server._websock_server._broadcast_buffer  # type: ignore[attr-defined]
-        original = buffer.window_generator
     except AttributeError:
         warnings.warn("rns_viz: this viser has no broadcast buffer to pace; slow pages are not paced", stacklevel=2)
+        return False
+    return gate_buffer(buffer, wait_s, sent)
+
+
+def gate_buffer(buffer: Any, wait_s: Callable[[int, float], float], sent: Callable[[int], None]) -> bool:
+    """The gate of :func:`install_gate` on one of viser's message buffers (the broadcast one, or a client's
+    own, patched before the client's reader starts). False (with a warning) if it has no window generator."""
+    try:
+        original = buffer.window_generator
+    except AttributeError:
+        warnings.warn("rns_viz: this viser's message buffer cannot be paced; slow pages are not paced", stacklevel=2)
         return False
 
     def window_generator(client_id: int, backlog_done_message: Any = None) -> AsyncGenerator[Sequence[Any], None]:
@@ -266,6 +280,25 @@ def install_gate(server: viser.ViserServer, wait_s: Callable[[int, float], float
 
     buffer.window_generator = window_generator
     return True
+
+
+class LateGate:
+    """A gate put on a client's own stream when it connects, before any app paces it: it lets every window
+    through until :meth:`attach` gives it an app's pace (the app of a page is built after its stream starts)."""
+
+    def __init__(self) -> None:
+        self._wait_s: Callable[[int, float], float] = lambda _client, _since: 0.0
+        self._sent: Callable[[int], None] = lambda _client: None
+
+    def attach(self, wait_s: Callable[[int, float], float], sent: Callable[[int], None]) -> bool:
+        self._wait_s, self._sent = wait_s, sent
+        return True
+
+    def wait_s(self, client_id: int, since_last_send_s: float) -> float:
+        return self._wait_s(client_id, since_last_send_s)
+
+    def sent(self, client_id: int) -> None:
+        self._sent(client_id)
 
 
 async def _paced(

@@ -18,15 +18,14 @@ import viser
 from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.loop.session import Session
-from rns_viz.live.operator.dual_arm import is_dual
+from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.published.snapshot import Snapshot
-from rns_viz.live.reach.region import arm_reach
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.live.teaching.rank_view import has_rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
-from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_boom_presets
+from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_presets
 from rns_viz.viz.panels.gain_panel import GainExplorerView
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
@@ -36,7 +35,8 @@ from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
-from rns_viz.viz.scene.view_toggles import ViewToggles
+from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
+from rns_viz.viz.server.drawn_factor import DrawnFactor
 
 FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
 CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
@@ -45,6 +45,9 @@ PLOT_S = 1.0 / 15.0  # live plots at 15 Hz (13 Hz when crowded)
 TEXT_S = 0.2  # status line and readouts at 5 Hz
 TARGET_HANDLE = "/base/target_handle"
 REACTION_LABEL = "arm reaction"
+KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
+# the names written in the scene that the *Labels* toggle hides (arrows' labels follow their arrows)
+LABELS = ("/base/label", "/beam/label", "/boom/label", "/spring/label", f"{TARGET_HANDLE}/label")
 
 
 class Renderer:
@@ -93,10 +96,12 @@ class Renderer:
         self.model = FsmsModel.from_key(snap.settings.model)  # drawing only (its own pinocchio data)
         spatial = len(self.model.task_rows) == 3  # the handle moves in 3-D and gives (x, y, z)
         self.scene = FsmsScene(self.server, self.model, trail_frame="base")
-        self._reach = arm_reach(self.model)
+        self._reach = self.model.arm_reach
+        self.factor = DrawnFactor(self.model, self.gui, self.controls, self.view)  # the base's drawn factor
         self.teach = TeachScene(self.server, self.model, self.scene)
         self.rank = RankScene(self.server, self.model, self.scene.style)
-        dual = is_dual(self.model)
+        self.kind = operator_class(self.model)  # what the operator drives: the panel's folders, laws and words
+        dual = self.kind.compensates
         self.teach.reaction_label = "residual reaction" if dual else REACTION_LABEL
         self.gui.plots.sides = COMPENSATION_SIDES if dual else SUPPRESSION_SIDES
         st = self.scene.style
@@ -106,14 +111,14 @@ class Renderer:
             active_axes=(True, True, spatial),
             disable_rotations=True,
             depth_test=False,
-            position=self._home(snap) + np.array([0.0, 0.0, st.overlay_z]),
+            position=self.home(snap) + np.array([0.0, 0.0, st.overlay_z]),
         )
         self.handle.on_update(self.controls.on_drag)
         self.controls.spatial_target = spatial
         self.controls.target_lift = np.array([0.0, 0.0, st.overlay_z])
         if self.base_panel is not None:
             self.base_panel.for_model(self.model)
-        show_boom_presets(self.gui, snap.settings.model)
+        show_presets(self.gui.presets, self.gui.menu, snap.settings.model)
         self.gui.target_text.content = target_text(self.model)
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
@@ -122,9 +127,9 @@ class Renderer:
             f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
         )
         self.scene.set_target(snap.target)
-        self.explorer.build_scene(self.scene.style, self.model.n - len(self.model.selected) == 1)
+        self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
 
-    def _home(self, snap: Snapshot) -> np.ndarray:
+    def home(self, snap: Snapshot) -> np.ndarray:
         """Where the target handle rests: the session's target, else the end effector."""
         if snap.target is not None:
             return np.asarray(snap.target, dtype=float)
@@ -141,10 +146,13 @@ class Renderer:
         self.names_drawn |= built
         g, controls = self.gui, self.controls
         with controls.quiet():
-            defaults = defaults_for(snap.settings.model)
+            defaults = defaults_for(self.model)
             g.kick_peak.min, g.kick_peak.max = -defaults.kick_range_N, defaults.kick_range_N
         controls.show(g.kick_peak, defaults.kick_peak_N)
         controls.show(g.exaggeration, defaults.exaggeration)
+        controls.show(g.auto_exaggeration, defaults.auto_exaggeration)
+        kept = {name for name in KEPT_ACROSS_MODELS if self.view.on(name)}  # the viewer's choice, not the model's
+        self.view.show_only(first_look(self.model) | kept)  # the new model's first look
         self._seen = _Seen()
         self.sync_settings(snap)
         self.model_name = snap.settings.model
@@ -176,10 +184,11 @@ class Renderer:
         if snap.epoch != seen.epoch or jumped:
             seen.epoch = snap.epoch
             self.scene.clear_trail()
-        self._draw_state(snap)
-        exaggeration = float(self.controls.good(self.gui.exaggeration))
+        exaggeration = self.factor.for_frame(snap)
+        self._draw_state(snap, exaggeration)
         q_shadow = None if snap.q_shadow is None else self._drawn(snap.q_shadow, exaggeration)
         self.teach.draw(snap, q_shadow, exaggeration, self.view)
+        self._apply_view()
         self.rank.draw(self.view.on("rank"))
         if snap.overlay_version != seen.overlay_version:
             seen.overlay_version = snap.overlay_version
@@ -200,15 +209,27 @@ class Renderer:
             seen.next_text = now + TEXT_S
             self._update_text(snap)
 
-    def _draw_state(self, snap: Snapshot) -> None:
-        """The arm, the base and the reaction arrow, when what a viewer sees changed."""
+    def _apply_view(self) -> None:
+        """The toggles of *Show in the scene* the render thread owns: labels, other paths, the gain map."""
+        seen, view = self._seen, self.view
+        labels = view.on("labels")
+        if labels != seen.labels:
+            seen.labels = labels
+            for name in LABELS:
+                handle = self.server.scene.get_handle_by_name(name)
+                if handle is not None:
+                    handle.visible = labels
+            self.teach.ghost.label.visible = labels
+        paths = view.on("paths")
+        if paths != seen.paths:
+            seen.paths = paths
+            seen.overlay_version = -1  # redrawn with or without the family
+        self.explorer.show(view.on("gain_map"), self.scene)
+
+    def _draw_state(self, snap: Snapshot, exaggeration: float) -> None:
+        """The arm, the base and the reaction arrow (and the base label's factor), when what a viewer sees changed."""
         seen = self._seen
-        exaggeration = float(self.controls.good(self.gui.exaggeration))
         q = self._drawn(snap.q, exaggeration) if np.all(np.isfinite(snap.q)) else seen.q
-        if exaggeration != seen.exaggeration:
-            label = self.server.scene.get_handle_by_name("/base/label")
-            if label is not None:
-                label.text = f"base x_b (drawn ×{exaggeration:g})"  # type: ignore[attr-defined]
         if q is not None and (not np.array_equal(q, seen.q) or exaggeration != seen.exaggeration):
             seen.q, seen.exaggeration = q, exaggeration
             with self.server.atomic():
@@ -224,7 +245,7 @@ class Renderer:
         pose = snap.orientation is not None and snap.orientation.on  # a pose handle: rotation rings too
         if snap.target_version != seen.target_version or pose != seen.pose:
             seen.target_version, seen.pose = snap.target_version, pose
-            home = self._home(snap)
+            home = self.home(snap)
             if np.all(np.isfinite(home)):
                 self.handle.position = home + np.array([0.0, 0.0, self.scene.style.overlay_z])
             self.handle.disable_rotations, self.controls.pose_target = not pose, pose
@@ -250,7 +271,7 @@ class Renderer:
         if ov.model != self.model_name:  # a switch published after this frame's snapshot: drawn once rebuilt
             self._seen.overlay_version = -1
             return
-        curves = list(ov.family or [])
+        curves = list(ov.family or []) if self.view.on("paths") else []  # the current path is always drawn
         if ov.current is not None:
             curves.append(ov.current)
         if curves:
@@ -305,7 +326,7 @@ class Renderer:
         """While a preset runs its own motion (no target) the handle stays on the end effector."""
         if snap.settings.preset is None or snap.target is not None or not np.all(np.isfinite(snap.q)):
             return
-        home = self._home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
+        home = self.home(snap) + np.array([0.0, 0.0, self.scene.style.overlay_z])
         if np.linalg.norm(home - np.asarray(self.handle.position)) > 0.5 * self.scene.style.marker_radius:
             self.handle.position = home
 
@@ -343,14 +364,14 @@ class Renderer:
         if self.base_panel is not None:
             self.base_panel.sync(snap, self.model)
         g.preset_info.content = preset_description(st.preset)
-        on_path = self.model.n - len(self.model.selected) == 1
+        on_path = self.kind.follows == "path"
         g.path_folder.visible = on_path
         g.target_folder.visible = not on_path
         task_gains = not on_path and st.law != "velocity"
         joint_gains = on_path and st.law != "velocity"
         g.gains["G_p"].visible = g.gains["G_d"].visible = task_gains
         g.gains["k_p"].visible = g.gains["k_d"].visible = joint_gains
-        g.law.disabled = is_dual(self.model)  # one law for dual arms: the compensating law
+        g.law.disabled = len(self.kind.laws) == 1  # one law for dual arms: the compensating law
 
 
 class _Seen:
@@ -371,3 +392,5 @@ class _Seen:
         self.next_plot = 0.0
         self.next_text = 0.0
         self.plot_mode = ""
+        self.labels: bool | None = None  # the view toggles last applied
+        self.paths: bool | None = None

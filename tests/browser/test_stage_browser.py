@@ -1,0 +1,105 @@
+"""The stage in a real Chromium, one page per bundled model resized to a projector, a laptop and a phone:
+the arm (its joints and its end-effector frame), projected by the page's own camera, lies inside the
+view and spans a stated fraction of it; at the two larger sizes the base-deflection plot is inside the
+viewport without scrolling; Frame robot brings the arm back after the camera was moved away.
+Screenshots: artifacts/stage_<model>_<w>x<h>.png.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rns_viz.viz.server.app import RnsApp, start_app
+from tests.support.browser import (
+    PROJECT,
+    browser_page,
+    dismiss_notifications,
+    screenshot,
+    settle_for_picture,
+    wait_for_nodes,
+    wait_until,
+)
+
+SIZES = ((1920, 1080), (1366, 768), (390, 844))
+# The arm, base joint to end effector, spans at least this fraction of the view's width or height. Measured
+# (software WebGL): trep 0.41 / 0.53 / 0.82, planar3r 0.34 / 0.36 / 0.68, boom7 0.25 at all three sizes,
+# trep2 0.25 / 0.33 / 0.50 at 1920x1080 / 1366x768 / 390x844; the bound leaves room for the arm's pose.
+MIN_SPAN = 0.2
+# a point given in a scene node's frame (m) to page pixels by the page's own camera (PROJECT: the node's origin)
+PROJECT_IN_NODE = """([name, x, y, z]) => {
+  const m = window.__viserMutable, obj = m.nodeRefFromName[name], cam = m.camera;
+  obj.updateWorldMatrix(true, false);
+  cam.updateMatrixWorld();
+  const mul = (M, v) => [0, 1, 2, 3].map((r) => M[r] * v[0] + M[4 + r] * v[1] + M[8 + r] * v[2] + M[12 + r] * v[3]);
+  const world = mul(obj.matrixWorld.elements, [x, y, z, 1]);
+  const c = mul(cam.projectionMatrix.elements, mul(cam.matrixWorldInverse.elements, world));
+  const rect = m.canvas.getBoundingClientRect();
+  return [rect.left + ((c[0] / c[3] + 1) / 2) * rect.width, rect.top + ((1 - c[1] / c[3]) / 2) * rect.height];
+}"""
+
+
+def arm_pixels(page, names: list[str], app: RnsApp) -> np.ndarray:
+    """The joints' origins and the end-effector frame (as drawn now, in the base node's frame), in page pixels."""
+    joints = [page.evaluate(PROJECT, [name, 0.0]) for name in names]
+    robot = app.scene.robot
+    base = robot.base_placement()
+    hand = base.rotation.T @ (robot.ee_position() - base.translation)
+    hand_px = page.evaluate(PROJECT_IN_NODE, [robot.node_names[app.model.m], *map(float, hand)])
+    return np.array([*joints, hand_px])
+
+
+def canvas_box(page) -> dict[str, float]:
+    return page.evaluate(
+        "() => { const r = window.__viserMutable.canvas.getBoundingClientRect();"
+        " return {x: r.left, y: r.top, w: r.width, h: r.height}; }"
+    )
+
+
+def arm_on_screen(page, names: list[str], app: RnsApp) -> tuple[bool, float]:
+    """Whether the arm's points lie in the visible canvas (and inside the viewport), and the span fraction."""
+    px = arm_pixels(page, names, app)
+    c = canvas_box(page)
+    vw, vh = page.viewport_size["width"], page.viewport_size["height"]
+    x0, y0, x1, y1 = max(c["x"], 0), max(c["y"], 0), min(c["x"] + c["w"], vw), min(c["y"] + c["h"], vh)
+    inside = bool(np.all((px[:, 0] >= x0) & (px[:, 0] <= x1) & (px[:, 1] >= y0) & (px[:, 1] <= y1)))
+    span = max(np.ptp(px[:, 0]) / (x1 - x0), np.ptp(px[:, 1]) / (y1 - y0))
+    return inside, float(span)
+
+
+@pytest.mark.parametrize("model", ["trep", "planar3r", "boom7", "trep2"])
+def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
+    app = start_app(model, port=0, verbose=False)
+    try:
+        joints = [name for name in app.scene.robot.node_names[app.model.m :] if name]
+        w0, h0 = SIZES[0]
+        with browser_page(app.server, width=w0, height=h0) as page:
+            wait_for_nodes(page, set(joints))
+            dismiss_notifications(page)
+            client = next(iter(app.server.get_clients().values()))
+            for w, h in SIZES:
+                page.set_viewport_size({"width": w, "height": h})
+                wait_until(lambda w=w: client.camera.image_width not in (0, w0) or w == w0, 10.0, "the new size")
+                app.frame_robot(client)  # a page opened at this size is framed on its first camera message
+                wait_until(lambda: arm_on_screen(page, joints, app)[0], 15.0, f"the arm in view at {w}x{h}")
+                inside, span = arm_on_screen(page, joints, app)
+                print(f"\n{model} {w}x{h}: arm spans {span:.3f} of the view", end="")
+                assert inside and span >= MIN_SPAN, (w, h, span)
+                if w >= 1366:  # the base-deflection chart: in the viewport, no scrolling
+                    chart = page.get_by_text("Base vibration x_b").first
+                    box = chart.bounding_box()
+                    assert box is not None and box["y"] >= 0 and box["y"] + box["height"] <= h, box
+                    assert box["x"] >= 0 and box["x"] + box["width"] <= w
+                settle_for_picture(page, 20)
+                screenshot(page, f"stage_{model}_{w}x{h}")
+            # Frame robot after the camera flew away: the arm is back in view
+            page.set_viewport_size({"width": 1366, "height": 768})
+            client.camera.position = client.camera.position + np.array(
+                [0.0, 0.0, 50.0 * float(np.ptp(app.scene.framed))]
+            )
+            client.camera.look_at = client.camera.look_at + np.array([40.0, 0.0, 0.0])
+            wait_until(lambda: not arm_on_screen(page, joints, app)[0], 10.0, "the arm out of view")
+            page.get_by_role("button", name="Frame robot").click()
+            wait_until(lambda: arm_on_screen(page, joints, app)[0], 15.0, "Frame robot to bring the arm back")
+    finally:
+        app.stop()
