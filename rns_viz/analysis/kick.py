@@ -10,8 +10,9 @@ xi_i(T) being mode i's state at the push's end T (closed form of the sampled hal
 complex pair's part on its upper pole (Re(a e + conj) = Re(2 a e)). E = sum |a_i| e^(-sigma_i tau) bounds
 |y|. From y (:mod:`rns_viz.analysis.modal_sums`):
 
-- peak P: max |y| (samples during the push; after it, scanned forward while E can exceed the largest top
-  found, the sampled tops near it refined);
+- peak P: max |y| (through the push at every control step, as the simulator logs it, where its modes'
+  bound allows more than the rest; after it, scanned forward while E can exceed the largest top found, the
+  sampled tops near it refined);
 - settle time: after the push's end, the last time |y| reaches 10 % of P: scanned back from where E falls
   to that level, a turn of the slowest swing at a time, the tops between samples refined, then solved for;
 - decay rate sigma_b: ln 10 over the settle time, the mean rate at which one sees the deflection fall to
@@ -115,29 +116,34 @@ def pulse_steps(kick: Kick, dt: float) -> np.ndarray:
     return np.append(np.arange(spacing, steps, spacing)[: PULSE_SAMPLES - 1], steps).astype(float)
 
 
-def pulse_states(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float, steps: np.ndarray) -> np.ndarray:
-    """xi_i after ``steps`` (J,) control steps into a unit half-sine push, (..., s, J).
+def pulse_modes(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """xi_i through a unit half-sine push as modes: xi_i(t) = c_i e^(lambda_i t) + b_i+ e^(i w t) + b_i- e^(-i w t),
+    w = pi / duration (for the step map at its steps t = k dt). c (..., s), b (..., s, 2).
 
-    Step map (``mu`` given): xi_{k+1} = mu xi_k + sin(w dt (k + 1/2)), w = pi / duration, the force
-    at mid-step (the simulator samples it at RK4's stages, of which the midpoint carries 2/3):
+    Step map (``mu`` given): xi_{k+1} = mu xi_k + sin(w dt (k + 1/2)), the force at mid-step (the simulator
+    samples it at RK4's stages, of which the midpoint carries 2/3):
         xi_K = [e^(i w dt/2) (mu^K - z^K) / (mu - z) - c.c.(z)] / 2i,   z = e^(i w dt).
     Continuous (``mu`` None): xi' = lambda xi + sin(w t), xi(t) = (w e^(lambda t) - w cos wt - lambda sin wt)
     / (lambda^2 + w^2).
     """
     w = math.pi / duration
-    k = np.asarray(steps, dtype=float)
-    with np.errstate(over="ignore", invalid="ignore"):  # a growing loop's modes may overflow: it is unstable anyway
-        e = _powers(lam, k * dt)  # e^(lambda t) = mu^k
-    if mu is None:
-        t, lam = k * dt, lam[..., None]
-        return (w * e - w * np.cos(w * t) - lam * np.sin(w * t)) / (lam * lam + w * w)
-    # = e c - sum over z of g_z z^K, with c = sum g_z and g_z = +-e^(+-i w dt/2) / (2i (mu - z)) per mode
-    z = np.exp(np.array([1j, -1j]) * w * dt)
-    with np.errstate(over="ignore", invalid="ignore"):
-        diff = mu[..., None] - z
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # a growing loop may overflow: unstable
+        if mu is None:
+            denominator = lam * lam + w * w
+            b = np.stack([-0.5 * w - lam / 2j, -0.5 * w + lam / 2j], axis=-1) / denominator[..., None]
+            return w / denominator, b
+        diff = mu[..., None] - np.exp(np.array([1j, -1j]) * w * dt)
         diff = np.where(np.abs(diff) < 1e-12, 1e-12, diff)  # mu at the pulse's frequency: never in practice
         g = np.array([1.0, -1.0]) * np.exp(np.array([0.5j, -0.5j]) * w * dt) / (2j * diff)  # (..., s, 2)
-        return e * g.sum(axis=-1)[..., None] - g @ z[:, None] ** k
+        return g.sum(axis=-1), -g
+
+
+def pulse_states(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float, steps: np.ndarray) -> np.ndarray:
+    """xi_i after ``steps`` (J,) control steps into a unit half-sine push, (..., s, J) (:func:`pulse_modes`)."""
+    t = np.asarray(steps, dtype=float) * dt
+    c, b = pulse_modes(lam, mu, dt, duration)
+    with np.errstate(over="ignore", invalid="ignore"):  # a growing loop's modes may overflow: it is unstable anyway
+        return _powers(lam, t) * c[..., None] + b @ np.exp(np.array([[1j], [-1j]]) * (math.pi / duration) * t)
 
 
 def _powers(lam: np.ndarray, times: np.ndarray) -> np.ndarray:
@@ -178,13 +184,15 @@ def respond(
     swing_map: np.ndarray,
     pulse_times: np.ndarray,
     margins: tuple[np.ndarray, np.ndarray],
+    push: tuple[np.ndarray, np.ndarray, float, int],
 ) -> KickResponse:
     """The kick's effect on K stable loops.
 
     lam (K, s): the poles (1/s) that carry y and L after the push; a (K, s), a_L (K, r, s): their parts in
     y and in L = S H_bm theta' at the push's end, y(T + tau) = Re sum a e^(lambda tau); y_pulse (K, J) and
     L_pulse (K, r, J): y and L during the push at ``pulse_times`` (J,) s, the last at its end; swing_map
-    (n, r): (S H_bm)^+; margins: how far each joint may turn down and up to its limits (n,), rad.
+    (n, r): (S H_bm)^+; margins: how far each joint may turn down and up to its limits (n,), rad; push: y
+    through the push as a sum of modes (poles (K, p), parts (K, p)), and the control step (s) and steps in it.
     """
     K = len(lam)
     a, a_L = fold_pairs(lam, a), fold_pairs(lam, a_L)
@@ -203,6 +211,7 @@ def respond(
     edges = np.stack([np.zeros(K), np.minimum(turn, horizon * SEGMENTS[1]), *(horizon * f for f in SEGMENTS[1:])], 1)
     sums = _grid(lam, edges, a_int)
     peak = modal_sums.peak(lam, a, at_pulse.max(axis=1))
+    peak = np.maximum(peak, _push_peak(*push, peak))
     level = SETTLE_LEVEL * peak
     t10 = modal_sums.last_above(lam, a, modal_sums.envelope_time(sigma, terms, level), level)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -227,6 +236,17 @@ def respond(
     reason[swing > MAX_SWING_RAD] = SWING
     reason[passes] = LIMIT
     return KickResponse(peak, t10, decay, top, swing, reason)
+
+
+def _push_peak(lam: np.ndarray, a: np.ndarray, dt: float, steps: int, floor: np.ndarray) -> np.ndarray:
+    """max |y| over the control steps through the push (as the simulator logs them) where the sum of its modes'
+    parts (bounding it, none grows) exceeds ``floor`` (K,); 0 elsewhere."""
+    out = np.zeros(len(lam))
+    rows = np.flatnonzero(np.abs(a).sum(axis=1) > floor)
+    if len(rows):
+        at = np.full(len(rows), dt)
+        out[rows] = np.abs(modal_sums.grid_sums(lam[rows], at, at, steps, a[rows, None])[:, 0].real).max(axis=1)
+    return out
 
 
 def _grid(lam: np.ndarray, edges: np.ndarray, weights: np.ndarray) -> np.ndarray:

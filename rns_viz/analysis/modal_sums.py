@@ -17,6 +17,7 @@ NEAR_PEAK = 0.97  # ... and above this fraction of the largest sample for the pe
 TOP_STEPS = 6  # Newton (or bisection) steps on y' = 0 to a top ...
 CROSSING_STEPS = 12  # ... and on |y| = level where it falls through the level
 ENVELOPE_STEPS = 8  # Newton steps on the bound's log
+SETTLED = 1e-13  # relative step under which a Newton iteration has converged
 MAX_WINDOWS = 200  # windows scanned per sum (a few in practice) ...
 LONGER_AFTER = 8  # ... their samples doubled every this many windows ...
 MAX_WINDOW_SAMPLES = 1024  # ... up to this many
@@ -48,7 +49,10 @@ def _falling_root(slope_of, lo: np.ndarray, hi: np.ndarray, t: np.ndarray, steps
         lo, hi = np.where(before, t, lo), np.where(before, hi, t)
         with np.errstate(divide="ignore", invalid="ignore"):
             newton = t - g / dg
-        t = np.where((dg < 0) & (newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
+        moved = np.where((dg < 0) & (newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
+        if np.all(np.abs(moved - t) <= SETTLED * (1.0 + np.abs(t))):  # every root to rounding (or no rows)
+            return moved
+        t = moved
     return t
 
 

@@ -18,6 +18,7 @@ from rns_viz.analysis.kick import (
     KEPT_PART,
     KickResponse,
     fold_pairs,
+    pulse_modes,
     pulse_states,
     pulse_steps,
     reason_text,
@@ -101,6 +102,7 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     steps = pulse_steps(kick, loop.dt)
     discrete = mu if loop.view == "discrete" else None
     xi = pulse_states(seen, discrete, loop.dt, kick.duration, steps)  # (K, seen, J)
+    c, b = pulse_modes(seen, discrete, loop.dt, kick.duration)  # the same as modes, for y between the samples
     after = kick.peak * y_gain * xi[..., -1]
     pair = np.abs(fold_pairs(seen, after))
     pair = np.where(seen.imag < 0, np.abs(2 * after), pair)  # the lower pole shows its pair's amplitude too
@@ -111,7 +113,8 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     dominant = np.zeros(count, dtype=int)
     if stable.any():
         rows = np.flatnonzero(stable)
-        resp = _respond(loop, seen[rows], xi[rows], V[rows], forcing[rows], y_gain[rows], C_L, steps)
+        push = kick.peak * y_gain[rows] * c[rows], kick.peak * (y_gain[rows, :, None] * b[rows]).sum(axis=1)
+        resp = _respond(loop, seen[rows], xi[rows], V[rows], forcing[rows], y_gain[rows], C_L, steps, push)
         peak[rows], settle[rows], swing[rows], reason[rows] = resp.peak, resp.settle_time, resp.swing, resp.reason
         base_rate[rows] = resp.decay_rate
         dominant[rows] = k + resp.dominant
@@ -152,9 +155,11 @@ def _respond(
     y_gain: np.ndarray,
     C_L: np.ndarray,
     steps: np.ndarray,
+    push: tuple[np.ndarray, np.ndarray],
 ) -> KickResponse:
     """The kick's response at K stable loops from their observable modes (lam, forcing, y_gain: (K, s); V
-    (K, s, s); xi (K, s, J) the modes' states through the push at ``steps``); its ``dominant`` indexes these.
+    (K, s, s); xi (K, s, J) the modes' states through the push at ``steps``; ``push``: y through the push as
+    modes, its parts on lam (K, s) and on e^(+-i w t) (K, 2)); its ``dominant`` indexes these modes.
 
     Through the push every mode counts (fast ones too: they cancel slower ones while it lasts); after it,
     :func:`~rns_viz.analysis.kick.respond` follows the modes with a part in y or in the integral of L (a
@@ -163,6 +168,10 @@ def _respond(
     its largest, with parts 0).
     """
     kick = loop.kick
+    w = np.pi / kick.duration
+    push_lam = np.concatenate([lam, np.broadcast_to([1j * w, -1j * w], (len(lam), 2))], axis=1)
+    push_a = np.concatenate(push, axis=1)
+    push_steps = int(steps[-1])
     L_gain = (C_L @ V) * forcing[:, None, :]  # (K, r, s)
     y_pulse = kick.peak * (y_gain[:, None, :] @ xi)[:, 0].real
     L_pulse = kick.peak * (L_gain @ xi).real
@@ -183,8 +192,9 @@ def _respond(
         take = order[rows, : int(needed[rows].max())]
         real = np.take_along_axis(part[rows], take, 1) >= KEPT_PART  # the batch's padding counts 0
         lam_p, a_p, a_L_p = (_modes(x[rows], take) for x in (lam, a, a_L))
+        through = (push_lam[rows], push_a[rows], loop.dt, push_steps)
         got = respond(lam_p, a_p * real, a_L_p * real[:, None, :], y_pulse[rows], L_pulse[rows], swing_map,
-                      steps * loop.dt, loop.joint_margins)  # fmt: skip
+                      steps * loop.dt, loop.joint_margins, through)  # fmt: skip
         for store, value in zip(out, (got.peak, got.settle_time, got.decay_rate, got.swing), strict=True):
             store[rows] = value
         reason[rows] = got.reason
