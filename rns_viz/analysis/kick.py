@@ -6,13 +6,15 @@ coordinate) is a sum of the loop's modes. With lambda_i the poles, v_i, w_i righ
 
     y(T + tau) = Re sum_i a_i e^(lambda_i tau),   a_i = (C v_i)(w_i^H B d) F xi_i(T),
 
-xi_i(T) being mode i's state at the push's end T (closed form of the sampled half-sine, below).
-With each complex pair's part on its upper pole (Re(a e + conj) = Re(2 a e)), the envelope
-E = |sum over real poles| + |sum over pairs| is smooth and bounds |y| from above. From it:
+xi_i(T) being mode i's state at the push's end T (closed form of the sampled half-sine, below), each
+complex pair's part on its upper pole (Re(a e + conj) = Re(2 a e)). E = sum |a_i| e^(-sigma_i tau) bounds
+|y|. From y (:mod:`rns_viz.analysis.modal_sums`):
 
-- peak P: max |y| (samples during and after the push, refined by Newton on y' = 0);
-- settle time: after the push's end, the last time |y| reaches 10 % of P (at or before E's last crossing;
-  where y swings there, on a swing within a turn before it, sampled and bisected);
+- peak P: max |y| (through the push at every control step, as the simulator logs it, where its modes'
+  bound allows more than the rest; after it, scanned forward while E can exceed the largest top found, the
+  sampled tops near it refined);
+- settle time: after the push's end, the last time |y| reaches 10 % of P: scanned back from where E falls
+  to that level, a turn of the slowest swing at a time, the tops between samples refined, then solved for;
 - decay rate sigma_b: ln 10 over the settle time, the mean rate at which one sees the deflection fall to
   10 % of its peak after the kick (about a pole's -Re lambda where one mode carries the decay);
 - arm swing: the joints' motion outside the reaction null space, (S H_bm)^+ integral of L dt (L = S H_bm
@@ -28,22 +30,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rns_viz.analysis import modal_sums
 from rns_viz.defaults import defaults_for
 from rns_viz.model import FsmsModel
 
 SETTLE_LEVEL = 0.1  # "time to 10 %"
-UPPER_LEVEL = 0.05  # the envelope is followed until its bound falls under this fraction of the peak
+UPPER_LEVEL = 0.05  # the swing is sampled until E falls under this fraction of the push's largest deflection
 LN10 = math.log(10.0)
 MAX_SWING_RAD = 0.5  # rad: beyond this joint swing the configuration-dependent terms change too much
 PULSE_SAMPLES = 6  # samples of y during the push (its middle among them)
-# y and its envelope are sampled evenly within segments of the time after the push: to where the largest
+# the integral of L is sampled evenly within segments of the time after the push: to where y's largest
 # term first turns back (at most the first fraction below), then between these fractions of a time when E
 # is surely under 5 % of the peak ...
 SEGMENTS = (0.0, 1 / 64, 1 / 16, 1 / 4, 1.0)
-SEGMENT_SAMPLES = 6  # ... this many samples each ...
-FINE_SAMPLES = 8  # ... and over the sample step in which the envelope crosses 10 % of the peak;
-SETTLE_SAMPLES = 16  # |y| over the turn before it, where it swings, ...
-BISECTIONS = 7  # ... and bisections of the flank where it falls through 10 %
+SEGMENT_SAMPLES = 6  # ... this many samples each
 KEPT_PART = 1e-3  # the modes followed after the push: their part in y or L at least this of the largest
 
 # Why a stable cell's prediction is not kept (index = KickResponse.reason; 0: kept).
@@ -116,31 +116,34 @@ def pulse_steps(kick: Kick, dt: float) -> np.ndarray:
     return np.append(np.arange(spacing, steps, spacing)[: PULSE_SAMPLES - 1], steps).astype(float)
 
 
-def pulse_states(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float, steps: np.ndarray) -> np.ndarray:
-    """xi_i after ``steps`` (J,) control steps into a unit half-sine push, (..., s, J).
+def pulse_modes(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """xi_i through a unit half-sine push as modes: xi_i(t) = c_i e^(lambda_i t) + b_i+ e^(i w t) + b_i- e^(-i w t),
+    w = pi / duration (for the step map at its steps t = k dt). c (..., s), b (..., s, 2).
 
-    Step map (``mu`` given): xi_{k+1} = mu xi_k + sin(w dt (k + 1/2)), w = pi / duration, the force
-    at mid-step (the simulator samples it at RK4's stages, of which the midpoint carries 2/3):
+    Step map (``mu`` given): xi_{k+1} = mu xi_k + sin(w dt (k + 1/2)), the force at mid-step (the simulator
+    samples it at RK4's stages, of which the midpoint carries 2/3):
         xi_K = [e^(i w dt/2) (mu^K - z^K) / (mu - z) - c.c.(z)] / 2i,   z = e^(i w dt).
     Continuous (``mu`` None): xi' = lambda xi + sin(w t), xi(t) = (w e^(lambda t) - w cos wt - lambda sin wt)
     / (lambda^2 + w^2).
     """
     w = math.pi / duration
-    k = np.asarray(steps, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # a growing loop may overflow: unstable
+        if mu is None:
+            denominator = lam * lam + w * w
+            b = np.stack([-0.5 * w - lam / 2j, -0.5 * w + lam / 2j], axis=-1) / denominator[..., None]
+            return w / denominator, b
+        diff = mu[..., None] - np.exp(np.array([1j, -1j]) * w * dt)
+        diff = np.where(np.abs(diff) < 1e-12, 1e-12, diff)  # mu at the pulse's frequency: never in practice
+        g = np.array([1.0, -1.0]) * np.exp(np.array([0.5j, -0.5j]) * w * dt) / (2j * diff)  # (..., s, 2)
+        return g.sum(axis=-1), -g
+
+
+def pulse_states(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float, steps: np.ndarray) -> np.ndarray:
+    """xi_i after ``steps`` (J,) control steps into a unit half-sine push, (..., s, J) (:func:`pulse_modes`)."""
+    t = np.asarray(steps, dtype=float) * dt
+    c, b = pulse_modes(lam, mu, dt, duration)
     with np.errstate(over="ignore", invalid="ignore"):  # a growing loop's modes may overflow: it is unstable anyway
-        e = _powers(lam, k * dt)  # e^(lambda t) = mu^k
-    if mu is None:
-        t, lam = k * dt, lam[..., None]
-        return (w * e - w * np.cos(w * t) - lam * np.sin(w * t)) / (lam * lam + w * w)
-    m = mu[..., None]
-    out = np.zeros(e.shape, dtype=complex)
-    with np.errstate(over="ignore", invalid="ignore"):
-        for sign in (1.0, -1.0):
-            z = np.exp(sign * 1j * w * dt)
-            diff = m - z
-            diff = np.where(np.abs(diff) < 1e-12, 1e-12, diff)  # mu at the pulse's frequency: never in practice
-            out += sign * np.exp(sign * 0.5j * w * dt) * (e - z**k) / diff
-    return out / 2j
+        return _powers(lam, t) * c[..., None] + b @ np.exp(np.array([[1j], [-1j]]) * (math.pi / duration) * t)
 
 
 def _powers(lam: np.ndarray, times: np.ndarray) -> np.ndarray:
@@ -172,59 +175,6 @@ def _bound_time(sigma: np.ndarray, terms: np.ndarray, level: np.ndarray) -> np.n
     return np.maximum(each.max(axis=1), 1e-3)
 
 
-def _sums(lam: np.ndarray, start: np.ndarray, step: np.ndarray, count: int, weights: np.ndarray) -> np.ndarray:
-    """sum_i w_i e^(lambda_i t_k) at t_k = start + k step, k < count, for weights (K, W, s): (K, W, count).
-    e^(lambda t_k) by recurrence (a product per sample, no exponential), the loops' axis last (fastest)."""
-    e = np.exp(lam * start[:, None]).T.copy()  # (s, K)
-    ratio = np.exp(lam * step[:, None]).T.copy()
-    w = np.ascontiguousarray(weights.transpose(1, 2, 0))  # (W, s, K)
-    out = np.empty((count, *w.shape[::2]), dtype=complex)  # (count, W, K)
-    for k in range(count):
-        if k:
-            e *= ratio
-        np.einsum("wsk,sk->wk", w, e, out=out[k])
-    return out.transpose(2, 1, 0)
-
-
-def _last_crossing(times: np.ndarray, values: np.ndarray, level: np.ndarray) -> np.ndarray:
-    """Last time a sampled, positive ``values`` is at or above ``level``, log-interpolated to the next
-    sample; the first time if never; inf if still above at the last sample."""
-    above = values >= level[:, None]
-    count = values.shape[1]
-    last = count - 1 - np.argmax(above[:, ::-1], axis=1)
-    last = np.where(above.any(axis=1), last, 0)
-    nxt = np.minimum(last + 1, count - 1)
-    t0, t1 = np.take_along_axis(times, last[:, None], 1)[:, 0], np.take_along_axis(times, nxt[:, None], 1)[:, 0]
-    v0, v1 = np.take_along_axis(values, last[:, None], 1)[:, 0], np.take_along_axis(values, nxt[:, None], 1)[:, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        f = np.log(v0 / level) / np.log(v0 / v1)
-    crossing = t0 + np.clip(np.nan_to_num(f, nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0) * (t1 - t0)
-    crossing = np.where(above.any(axis=1), crossing, times[:, 0])
-    return np.where(above[:, -1], np.inf, crossing)
-
-
-def _crossings(
-    lam: np.ndarray, parts: np.ndarray, times: np.ndarray, envelope: np.ndarray, levels: np.ndarray
-) -> np.ndarray:
-    """Last times (s) the envelope sampled at ``times`` (K, N) is at ``levels`` (L, K): the last sample at or
-    above each, then FINE_SAMPLES over the step after it, log-interpolated there. (L, K)."""
-    K, count = envelope.shape
-    L = len(levels)
-    above = envelope[None] >= levels[..., None]  # (L, K, N)
-    last = np.where(above.any(axis=2), count - 1 - np.argmax(above[..., ::-1], axis=2), 0)
-    nxt = np.minimum(last + 1, count - 1)
-    t0 = np.take_along_axis(np.broadcast_to(times, (L, K, count)), last[..., None], 2)[..., 0].ravel()
-    t1 = np.take_along_axis(np.broadcast_to(times, (L, K, count)), nxt[..., None], 2)[..., 0].ravel()
-    fine = (t1 - t0) / FINE_SAMPLES
-    parts_l = np.tile(parts, (L, 1, 1))
-    rest, osc = _sums(np.tile(lam, (L, 1)), t0, fine, FINE_SAMPLES + 1, parts_l).transpose(1, 0, 2)
-    fine_times = t0[:, None] + fine[:, None] * np.arange(FINE_SAMPLES + 1)
-    crossing = _last_crossing(fine_times, np.abs(rest.real) + np.abs(osc), levels.ravel()).reshape(L, K)
-    crossing[~above.any(axis=2)] = 0.0  # under the level from the kick's end on
-    crossing[above[..., -1]] = np.inf  # still above at the end of the samples: never, for the bound
-    return crossing
-
-
 def respond(
     lam: np.ndarray,
     a: np.ndarray,
@@ -234,37 +184,36 @@ def respond(
     swing_map: np.ndarray,
     pulse_times: np.ndarray,
     margins: tuple[np.ndarray, np.ndarray],
+    push: tuple[np.ndarray, np.ndarray, float, int],
 ) -> KickResponse:
     """The kick's effect on K stable loops.
 
     lam (K, s): the poles (1/s) that carry y and L after the push; a (K, s), a_L (K, r, s): their parts in
     y and in L = S H_bm theta' at the push's end, y(T + tau) = Re sum a e^(lambda tau); y_pulse (K, J) and
     L_pulse (K, r, J): y and L during the push at ``pulse_times`` (J,) s, the last at its end; swing_map
-    (n, r): (S H_bm)^+; margins: how far each joint may turn down and up to its limits (n,), rad.
+    (n, r): (S H_bm)^+; margins: how far each joint may turn down and up to its limits (n,), rad; push: y
+    through the push as a sum of modes (poles (K, p), parts (K, p)), and the control step (s) and steps in it.
     """
     K = len(lam)
     a, a_L = fold_pairs(lam, a), fold_pairs(lam, a_L)
     sigma = -lam.real
-    oscillating = lam.imag != 0  # a pair (on its upper pole): enveloped in E; real poles are summed
     terms = np.abs(a)
     with np.errstate(divide="ignore", invalid="ignore"):
         a_int = np.where(lam[:, None, :] != 0, a_L / lam[:, None, :], 0.0)  # integral of L after the push, per mode
 
-    # y and E after the push on a grid finer near its end (to where the largest term first turns back, then
-    # in segments), until E's bound is under 5 % of the push's largest deflection; the peak refined there.
+    # The integral of L after the push on a grid finer near its end (to where y's largest term first turns
+    # back, then in segments), until the bound on |y| is under 5 % of the push's largest deflection.
     at_pulse = np.abs(y_pulse)
     horizon = _bound_time(sigma, terms, UPPER_LEVEL * at_pulse.max(axis=1))
-    big = np.take_along_axis(lam, np.argmax(terms, axis=1)[:, None], 1)[:, 0]
-    with np.errstate(divide="ignore"):  # where the largest term first turns back: the peak is near
+    big = lam[np.arange(K), np.argmax(terms, axis=1)]
+    with np.errstate(divide="ignore"):  # where the largest term first turns back: the swing is largest near
         turn = np.where(big.imag != 0, np.pi / np.abs(big.imag), 1.0 / -big.real)
-    edges = np.vstack([np.zeros(K), np.minimum(turn, horizon * SEGMENTS[1]), *(horizon * f for f in SEGMENTS[1:])])
-    parts = np.stack([np.where(oscillating, 0.0, a), np.where(oscillating, a, 0.0)], axis=1)
-    times, sums = _grid(lam, edges, np.concatenate([parts, a_int], axis=1))
-    rest, osc, integral_after = sums[:, 0], sums[:, 1], sums[:, 2:]  # real poles', pairs', integral of L
-    y = np.abs(rest.real + osc.real)
-    peak = _peak(lam, a, times, y, at_pulse)
-    (envelope_10,) = _crossings(lam, parts, times, np.abs(rest.real) + np.abs(osc), SETTLE_LEVEL * peak[None])
-    t10 = _last_on_y(lam, a, oscillating, envelope_10, SETTLE_LEVEL * peak)
+    edges = np.stack([np.zeros(K), np.minimum(turn, horizon * SEGMENTS[1]), *(horizon * f for f in SEGMENTS[1:])], 1)
+    sums = _grid(lam, edges, a_int)
+    peak = modal_sums.peak(lam, a, at_pulse.max(axis=1))
+    peak = np.maximum(peak, _push_peak(*push, peak))
+    level = SETTLE_LEVEL * peak
+    t10 = modal_sums.last_above(lam, a, modal_sums.envelope_time(sigma, terms, level), level)
     with np.errstate(divide="ignore", invalid="ignore"):
         decay = LN10 / t10  # the mean rate from the kick's end to 10 % of the peak
         at_10 = terms * np.exp(-sigma * t10[:, None])  # the pole whose term is largest at 10 %
@@ -275,11 +224,12 @@ def respond(
     before = np.concatenate([np.zeros_like(L_pulse[..., :1]), L_pulse[..., :-1]], 2)
     inside = np.cumsum(0.5 * (L_pulse + before) * dtau, 2)
     offset = inside[..., -1] - a_int.sum(axis=-1).real  # the integral at the push's end, minus the modes' start
-    integral = np.concatenate([inside, integral_after.real + offset[..., None], offset[..., None]], 2)
-    joints = np.einsum("nr,krj->knj", swing_map, integral)
-    swing = np.abs(joints).max(axis=(1, 2))
+    integral = np.concatenate([inside, sums.real + offset[..., None], offset[..., None]], 2)
+    joints = swing_map @ integral  # (K, n, samples)
+    lowest, highest = joints.min(axis=2), joints.max(axis=2)
+    swing = np.maximum(-lowest.min(axis=1), highest.max(axis=1))
     down, up = margins
-    passes = np.any((joints.min(axis=2) < -down) | (joints.max(axis=2) > up), axis=1)
+    passes = np.any((lowest < -down) | (highest > up), axis=1)
 
     reason = np.full(K, KEPT)
     reason[t10 <= 0] = WITHIN_KICK
@@ -288,62 +238,22 @@ def respond(
     return KickResponse(peak, t10, decay, top, swing, reason)
 
 
-def _grid(lam: np.ndarray, edges: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """sum_i w_i e^(lambda_i tau) for weights (K, W, s), tau evenly within each segment between ``edges``
-    (G + 1, K) s after the push: times (K, G SEGMENT_SAMPLES), sums (K, W, G SEGMENT_SAMPLES)."""
-    K, G = len(lam), len(edges) - 1
-    start = edges[:-1].ravel()  # (G K,) segment by segment
-    step = np.diff(edges, axis=0).ravel() / SEGMENT_SAMPLES
-    sums = _sums(np.tile(lam, (G, 1)), start, step, SEGMENT_SAMPLES, np.tile(weights, (G, 1, 1)))
-    times = start[:, None] + step[:, None] * np.arange(SEGMENT_SAMPLES)
-    times = np.concatenate([times[g * K : (g + 1) * K] for g in range(G)], axis=-1)
-    return times, np.concatenate([sums[g * K : (g + 1) * K] for g in range(G)], axis=-1)
-
-
-def _last_on_y(
-    lam: np.ndarray, a: np.ndarray, oscillating: np.ndarray, t_env: np.ndarray, level: np.ndarray
-) -> np.ndarray:
-    """The last time |y| itself reaches ``level``: at or before ``t_env``, where the envelope does. Where an
-    oscillation is part of the envelope there, |y| last reaches it on a swing within one turn of the
-    largest one before: sampled over that turn, the crossing bisected on the flank after the last sample."""
-    e = np.exp(lam * np.where(np.isfinite(t_env), t_env, 0.0)[:, None])
-    swings = np.abs(np.where(oscillating, a, 0.0) * e)
-    turning = np.isfinite(t_env) & (t_env > 0) & (swings.sum(axis=1) > 0.01 * level)
-    if not turning.any():
-        return t_env
-    rows = np.flatnonzero(turning)
-    lam, a = lam[rows], a[rows]
-    omega = np.abs(np.take_along_axis(lam, np.argmax(swings[rows], axis=1)[:, None], 1)[:, 0].imag)
-    end = t_env[rows]
-    begin = np.maximum(end - 2 * np.pi / omega, 0.0)
-    step = (end - begin) / SETTLE_SAMPLES
-    y = np.abs(_sums(lam, begin, step, SETTLE_SAMPLES + 1, a[:, None])[:, 0].real)
-    above = y >= level[rows, None]
-    last = np.where(above.any(axis=1), SETTLE_SAMPLES - np.argmax(above[:, ::-1], axis=1), 0)
-    lo, hi = begin + step * last, begin + step * np.minimum(last + 1, SETTLE_SAMPLES)
-    for _ in range(BISECTIONS):  # |y| falls through the level between lo (above) and hi (under)
-        mid = 0.5 * (lo + hi)
-        high = np.abs((a * np.exp(lam * mid[:, None])).sum(axis=1).real) >= level[rows]
-        lo, hi = np.where(high, mid, lo), np.where(high, hi, mid)
-    out = t_env.copy()
-    out[rows] = np.where(above.any(axis=1), lo, begin)
+def _push_peak(lam: np.ndarray, a: np.ndarray, dt: float, steps: int, floor: np.ndarray) -> np.ndarray:
+    """max |y| over the control steps through the push (as the simulator logs them) where the sum of its modes'
+    parts (bounding it, none grows) exceeds ``floor`` (K,); 0 elsewhere."""
+    out = np.zeros(len(lam))
+    rows = np.flatnonzero(np.abs(a).sum(axis=1) > floor)
+    if len(rows):
+        at = np.full(len(rows), dt)
+        out[rows] = np.abs(modal_sums.grid_sums(lam[rows], at, at, steps, a[rows, None])[:, 0].real).max(axis=1)
     return out
 
 
-def _peak(lam: np.ndarray, a: np.ndarray, times: np.ndarray, y: np.ndarray, pushed: np.ndarray) -> np.ndarray:
-    """The peak of |y|: the largest of the push's samples ``pushed`` (K, J) and of |y| sampled after it at
-    ``times`` (K, N), the largest of these refined by Newton on y' = 0."""
-    best = np.argmax(y, axis=1)
-    tp = np.take_along_axis(times, best[:, None], 1)[:, 0]
-    spacing = np.diff(times, axis=1)
-    reach = np.take_along_axis(spacing, np.minimum(best, spacing.shape[1] - 1)[:, None], 1)[:, 0]
-    for _ in range(2):
-        e = np.exp(lam * tp[:, None])
-        d1, d2 = (a * lam * e).sum(axis=1).real, (a * lam * lam * e).sum(axis=1).real
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tp = np.maximum(tp + np.clip(np.nan_to_num(-d1 / d2), -reach, reach), 0.0)
-    top = np.abs((a * np.exp(lam * tp[:, None])).sum(axis=1).real)
-    return np.maximum.reduce([pushed.max(axis=1), y.max(axis=1), top])
+def _grid(lam: np.ndarray, edges: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """sum_i w_i e^(lambda_i tau) for weights (K, W, s), tau evenly within each segment between ``edges``
+    (K, G + 1) s after the push: (K, W, G SEGMENT_SAMPLES)."""
+    step = np.diff(edges, axis=1) / SEGMENT_SAMPLES
+    return modal_sums.grid_sums(lam, edges[:, :-1], step, SEGMENT_SAMPLES, weights)
 
 
 def reason_text(code: int, swing: float) -> str:

@@ -18,6 +18,7 @@ from rns_viz.analysis.kick import (
     KEPT_PART,
     KickResponse,
     fold_pairs,
+    pulse_modes,
     pulse_states,
     pulse_steps,
     reason_text,
@@ -78,8 +79,8 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     gb = np.asarray(g_b, dtype=float)[..., None, None]
     gm = np.asarray(g_m, dtype=float)[..., None, None]
     shape = np.broadcast_shapes(gb.shape, gm.shape)[:-2]
-    A = (blocks[0] + gb * blocks[1] + gm * blocks[2]).reshape(-1, d, d)
-    mu, V = np.linalg.eig(A[:, k:, k:])
+    seen_blocks = [B[k:, k:] for B in blocks]  # the block x_b can show, at every gain setting
+    mu, V = np.linalg.eig((seen_blocks[0] + gb * seen_blocks[1] + gm * seen_blocks[2]).reshape(-1, d - k, d - k))
     kick = loop.kick
     observed = T[:, k:]
     C_y = kick.output @ observed[np.flatnonzero(loop.kept < loop.m)]  # (seen,): y on the observable block
@@ -97,10 +98,12 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     stable = -re.max(axis=1) > STABLE_MARGIN
     count = len(stable)
 
-    # Every mode's envelope after the kick, then the response where the loop is stable.
+    # Every mode's state through the push, its envelope after it, then the response where the loop is stable.
     steps = pulse_steps(kick, loop.dt)
     discrete = mu if loop.view == "discrete" else None
-    after = kick.peak * y_gain * pulse_states(seen, discrete, loop.dt, kick.duration, steps[-1:])[..., 0]
+    xi = pulse_states(seen, discrete, loop.dt, kick.duration, steps)  # (K, seen, J)
+    c, b = pulse_modes(seen, discrete, loop.dt, kick.duration)  # the same as modes, for y between the samples
+    after = kick.peak * y_gain * xi[..., -1]
     pair = np.abs(fold_pairs(seen, after))
     pair = np.where(seen.imag < 0, np.abs(2 * after), pair)  # the lower pole shows its pair's amplitude too
     amplitude = np.concatenate((np.zeros(hidden.shape), pair), axis=1)
@@ -110,8 +113,8 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     dominant = np.zeros(count, dtype=int)
     if stable.any():
         rows = np.flatnonzero(stable)
-        resp = _respond(loop, seen[rows], None if discrete is None else mu[rows], V[rows], forcing[rows],
-                        y_gain[rows], C_L, steps)  # fmt: skip
+        push = kick.peak * y_gain[rows] * c[rows], kick.peak * (y_gain[rows, :, None] * b[rows]).sum(axis=1)
+        resp = _respond(loop, seen[rows], xi[rows], V[rows], forcing[rows], y_gain[rows], C_L, steps, push)
         peak[rows], settle[rows], swing[rows], reason[rows] = resp.peak, resp.settle_time, resp.swing, resp.reason
         base_rate[rows] = resp.decay_rate
         dominant[rows] = k + resp.dominant
@@ -146,15 +149,17 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
 def _respond(
     loop: LinearLoop,
     lam: np.ndarray,
-    mu: np.ndarray | None,
+    xi: np.ndarray,
     V: np.ndarray,
     forcing: np.ndarray,
     y_gain: np.ndarray,
     C_L: np.ndarray,
     steps: np.ndarray,
+    push: tuple[np.ndarray, np.ndarray],
 ) -> KickResponse:
-    """The kick's response at K stable loops from their observable modes (lam, mu, V, forcing, y_gain: (K, s)
-    or (K, s, s)); its ``dominant`` indexes these modes.
+    """The kick's response at K stable loops from their observable modes (lam, forcing, y_gain: (K, s); V
+    (K, s, s); xi (K, s, J) the modes' states through the push at ``steps``; ``push``: y through the push as
+    modes, its parts on lam (K, s) and on e^(+-i w t) (K, 2)); its ``dominant`` indexes these modes.
 
     Through the push every mode counts (fast ones too: they cancel slower ones while it lasts); after it,
     :func:`~rns_viz.analysis.kick.respond` follows the modes with a part in y or in the integral of L (a
@@ -163,10 +168,13 @@ def _respond(
     its largest, with parts 0).
     """
     kick = loop.kick
-    xi = pulse_states(lam, mu, loop.dt, kick.duration, steps)  # (K, s, J) through the push
+    w = np.pi / kick.duration
+    push_lam = np.concatenate([lam, np.broadcast_to([1j * w, -1j * w], (len(lam), 2))], axis=1)
+    push_a = np.concatenate(push, axis=1)
+    push_steps = int(steps[-1])
     L_gain = (C_L @ V) * forcing[:, None, :]  # (K, r, s)
-    y_pulse = kick.peak * np.einsum("ks,ksj->kj", y_gain, xi).real
-    L_pulse = kick.peak * np.einsum("krs,ksj->krj", L_gain, xi).real
+    y_pulse = kick.peak * (y_gain[:, None, :] @ xi)[:, 0].real
+    L_pulse = kick.peak * (L_gain @ xi).real
     a, a_L = kick.peak * y_gain * xi[..., -1], kick.peak * L_gain * xi[:, None, :, -1]
     part = np.abs(fold_pairs(lam, a))
     part_L = np.linalg.norm(fold_pairs(lam, a_L), axis=1) / np.abs(lam)
@@ -175,6 +183,7 @@ def _respond(
     needed = np.maximum((part >= KEPT_PART).sum(axis=1), 1)
     order = np.argsort(-part, axis=1)
     split = int(np.percentile(needed, 80))
+    swing_map = loop.swing_map
     out = [np.empty(len(lam)) for _ in range(4)]
     reason, dominant = np.empty(len(lam), dtype=int), np.empty(len(lam), dtype=int)
     for rows in (np.flatnonzero(needed <= split), np.flatnonzero(needed > split)):
@@ -183,12 +192,13 @@ def _respond(
         take = order[rows, : int(needed[rows].max())]
         real = np.take_along_axis(part[rows], take, 1) >= KEPT_PART  # the batch's padding counts 0
         lam_p, a_p, a_L_p = (_modes(x[rows], take) for x in (lam, a, a_L))
-        got = respond(lam_p, a_p * real, a_L_p * real[:, None, :], y_pulse[rows], L_pulse[rows], loop.swing_map,
-                      steps * loop.dt, loop.joint_margins)  # fmt: skip
+        through = (push_lam[rows], push_a[rows], loop.dt, push_steps)
+        got = respond(lam_p, a_p * real, a_L_p * real[:, None, :], y_pulse[rows], L_pulse[rows], swing_map,
+                      steps * loop.dt, loop.joint_margins, through)  # fmt: skip
         for store, value in zip(out, (got.peak, got.settle_time, got.decay_rate, got.swing), strict=True):
             store[rows] = value
         reason[rows] = got.reason
-        dominant[rows] = np.take_along_axis(take, got.dominant[:, None], 1)[:, 0]
+        dominant[rows] = take[np.arange(len(rows)), got.dominant]
     return KickResponse(*out[:3], dominant, out[3], reason)
 
 
@@ -207,7 +217,11 @@ def _hidden_poles(blocks: list[np.ndarray], k: int, gb: np.ndarray, gm: np.ndarr
         return np.empty((len(gains), 0), dtype=complex)
     scale = max(np.abs(H0).max(), 1.0)
     used = np.array([np.abs(H).max() > 1e-9 * scale for H in (Hb, Hm)])
-    unique, index = np.unique(gains[:, used], axis=0, return_inverse=True)
+    if used.sum() == 1:  # a 1-D unique is many times faster than one over rows
+        unique, index = np.unique(gains[:, used][:, 0], return_inverse=True)
+        unique = unique[:, None]
+    else:
+        unique, index = np.unique(gains[:, used], axis=0, return_inverse=True)
     values = np.zeros((len(unique), 2))
     values[:, used] = unique
     H = H0 + values[:, 0, None, None] * Hb + values[:, 1, None, None] * Hm

@@ -3,6 +3,7 @@ message by a protocol-level client, the operator lock, hostile clicks, and the a
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Iterator
 from dataclasses import replace
@@ -259,7 +260,12 @@ def test_after_a_kick_the_panel_sets_the_measured_decay_beside_the_prediction(ap
         if measured is not None and np.isfinite(measured.rate):
             break
     assert measured is not None and np.isfinite(measured.rate)
-    assert measured.settle_time == pytest.approx(float(s.gain_view().current.base_time_to_10pct), rel=0.05)
+    # Where a swing's top passes 10 % of the peak by a hair the last one above may be the next or the previous
+    # in the nonlinear run: TREP at Fig. 10's gains, the linear loop's top at 6.01 s is 0.02 % over 10 %, the
+    # run's is under it, so the run reads the top a half turn (pi / omega, 0.58 s) before.
+    current = s.gain_view().current
+    predicted, half_turn = float(current.base_time_to_10pct), math.pi / float(current.base_frequency)
+    assert abs(measured.settle_time - predicted) <= max(0.05 * predicted, 1.05 * half_turn)
     # The render thread may first show an earlier fit (one a second after the kick): wait for the last one.
     shown = f"{measured.rate:.3g} 1/s"
     wait_until(lambda: shown in ex.predicted.content, 10.0, "the panel to show the last measured decay")
