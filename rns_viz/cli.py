@@ -356,7 +356,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="N",
         type=_positive_int,
         default=None,
-        help="with --each-visitor: simulations at once (default 3 per CPU core); later pages wait for a place",
+        help="with --each-visitor: simulations at once (default 1 per CPU core, at most 3); later pages wait",
     )
     serve.add_argument(
         "--idle-minutes",

@@ -65,6 +65,9 @@ def wait_applied(app: RnsApp) -> None:
 def test_two_visitors_kick_and_drag_each_their_own_simulation(room: Classroom) -> None:
     (a, app_a), (b, app_b) = visitors(room, 2)
     assert app_a.session is not app_b.session and app_a.lock.operator is not None
+    for app in (app_a, app_b):  # a page with a simulation of its own operates it: no Operator panel to give it away
+        (cid,) = app.lock.clients()
+        assert app.lock.operator == cid and app.connections.panels.panel(cid) is None
     for app in (app_a, app_b):
         app.session.advance(0.1)
 

@@ -23,9 +23,13 @@ BROWSER_ASK_S = 30.0  # s: how long a page may take to answer (it answers after 
 class Connections:
     """The clients of one server: notifications, operator rights and the per-client panels."""
 
-    def __init__(self, server: viser.ViserServer, password: str | None, seat_on_connect: bool = True) -> None:
-        """``seat_on_connect=False``: a visitor operates only after pressing Take control (OperatorLock)."""
+    def __init__(
+        self, server: viser.ViserServer, password: str | None, seat_on_connect: bool = True, shared: bool = True
+    ) -> None:
+        """``seat_on_connect=False``: a visitor operates only after pressing Take control (OperatorLock);
+        ``shared=False``: one page's own simulation, which it operates (no Operator panel)."""
         self.server = server
+        self.shared = shared
         self.password = password
         self.lock = OperatorLock(password, seat_on_connect=seat_on_connect)
         self.panels = OperatorPanels(self.lock, self.notify)
@@ -66,8 +70,11 @@ class Connections:
         return len(self.server.get_clients())
 
     def client_joined(self, client: viser.ClientHandle) -> None:
-        """Give the newcomer its operator panel."""
-        self.panels.add(client)
+        """Give the newcomer its operator panel (a page with a simulation of its own: only the seat)."""
+        if self.shared:
+            self.panels.add(client)
+        else:
+            self.lock.connect(client.client_id)
 
     def _ask_password(self, client: viser.ClientHandle) -> None:
         """The password modal, for a page whose browser has not given the password yet."""

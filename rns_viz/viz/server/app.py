@@ -61,6 +61,7 @@ class RnsApp:
         seat_on_connect: bool = True,
         pause_unwatched: bool = False,
         present: bool = False,
+        shared: bool = True,
     ) -> None:
         """``seat_on_connect=False``: nobody operates by connecting first, the seat goes to the first visitor who
         presses Take control (a server open to the network; see :func:`start_app`); ``models``: parameter files
@@ -68,11 +69,12 @@ class RnsApp:
         ``pace=False``: every page gets every update however slowly it draws; ``pause_unwatched``: the
         simulation pauses while no page is open and runs on when one comes (one student's app: its CPU
         is then ~2 % of a core, not ~12 %); ``present``: the projector's screen
-        (rns_viz.viz.panels.presentation)."""
+        (rns_viz.viz.panels.presentation); ``shared=False``: the app is one page's own simulation (a visitor's
+        in ``--each-visitor`` mode), which that page always operates: no Operator panel to take or release it."""
         self.server = server
         self.session = session
         self.password = password
-        self.connections = Connections(server, password, seat_on_connect)
+        self.connections = Connections(server, password, seat_on_connect, shared)
         model = session.snapshot().settings.model
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)

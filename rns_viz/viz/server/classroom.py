@@ -36,7 +36,11 @@ from rns_viz.viz.server.page_pacing import LateGate, gate_buffer
 from rns_viz.viz.server.presenter import WatchedSession, add_show_switch, add_watching_line, is_loopback, refuser
 from rns_viz.viz.server.visitor import CLOSED_TEXT, FULL_TEXT, Visitor
 
-VISITORS_PER_CORE = 3  # simulations per CPU core that keep real time (benchmarks/bench_visitors.py)
+# Simulations that keep real time (benchmarks/bench_visitors.py: TREP with its shadow run costs 27-36 % of a
+# core per visitor; 2 kept real time on 2 quiet cores, 3 did not): one per core, and no more than one
+# interpreter runs, however many cores (every visitor's threads share its lock)
+VISITORS_PER_CORE = 1
+VISITORS_PER_PROCESS = 3
 IDLE_PAUSE_S = 5 * 60.0  # wall s without input before a visitor's simulation is paused
 IDLE_CLOSE_S = 20 * 60.0  # wall s without input before it is closed and its place freed
 IDLE_CHECK_S = 5.0  # wall s between looks for idle visitors
@@ -50,8 +54,9 @@ INPUT_MESSAGES: tuple[type, ...] = tuple(
 
 
 def default_visitor_cap(cores: int | None = None) -> int:
-    """How many simulations this machine runs at once in real time: VISITORS_PER_CORE per core."""
-    return max(1, VISITORS_PER_CORE * (cores or os.cpu_count() or 1))
+    """How many simulations this machine runs at once in real time: VISITORS_PER_CORE per core, at most
+    VISITORS_PER_PROCESS."""
+    return max(1, min(VISITORS_PER_PROCESS, VISITORS_PER_CORE * (cores or os.cpu_count() or 1)))
 
 
 class Classroom:
@@ -201,7 +206,7 @@ class Classroom:
         # a fresh view for each app (the old app's callbacks stay with the old one)
         visitor.view = ClientView(self.server, client, None if gate is None else gate.attach)
         view = cast(viser.ViserServer, visitor.view)  # the app uses only what ClientView provides
-        app = RnsApp(view, session, password=None, models=self.models, pace=gate is not None).start()
+        app = RnsApp(view, session, password=None, models=self.models, pace=gate is not None, shared=False).start()
         with suppress(Exception):  # the page may have gone
             if watched is not None:
                 visitor.extra = add_watching_line(client)
