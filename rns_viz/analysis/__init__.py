@@ -3,7 +3,8 @@
 - :func:`linearise` -> :class:`LinearLoop`, A(g_b, g_m) = A0 + g_b A_b + g_m A_m about a rest configuration;
 - :func:`modes_of` -> :class:`Modes`, poles split into the base group and the arm group;
 - :func:`gain_map` / :func:`map_of` -> :class:`GainMap`, :func:`root_locus` -> :class:`Locus`;
-- :func:`loops_along` + :func:`authority` -> :class:`Authority` along a path; :func:`fit_decay` -> :class:`DecayFit`;
+- :func:`loops_along` + :func:`authority` -> :class:`Authority` along a path (:func:`joined` of runs);
+  :func:`fit_decay` -> :class:`DecayFit`;
 - :class:`Kick` (:func:`default_kick`): the push whose response a map predicts; :func:`measure_kick` reads a log alike.
 """
 
@@ -13,6 +14,7 @@ from rns_viz.analysis.authority import (
     KickMeasure,
     authority,
     fit_decay,
+    joined,
     loops_along,
     measure_kick,
 )
@@ -54,6 +56,7 @@ __all__ = [
     "default_kick",
     "fit_decay",
     "gain_map",
+    "joined",
     "law_kind",
     "linearise",
     "loops_along",

@@ -62,6 +62,17 @@ def authority(loops: list[LinearLoop], g_b: float, g_m: float) -> Authority:
     )
 
 
+def joined(parts: list[Authority]) -> Authority:
+    """The authorities of consecutive runs of configurations (at the same gains) as one, in their order."""
+    if not parts or any((p.g_b, p.g_m) != (parts[0].g_b, parts[0].g_m) for p in parts):
+        raise ValueError("joined() needs one or more authorities at the same gains")
+    arrays = {
+        name: np.concatenate([getattr(p, name) for p in parts])
+        for name in ("base_decay_rate", "arm_decay_rate", "base_damping_ratio", "stable", "coupling_norm")
+    }
+    return Authority(g_b=parts[0].g_b, g_m=parts[0].g_m, **arrays)
+
+
 @dataclass(frozen=True)
 class DecayFit:
     """An exponential envelope A e^(-rate t) fitted to ``|x|``; ``rate`` < 0 means growth."""

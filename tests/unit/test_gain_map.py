@@ -17,6 +17,7 @@ from rns_viz.analysis import (
     default_axes,
     fit_decay,
     gain_map,
+    joined,
     linearise,
     loops_along,
     map_of,
@@ -241,6 +242,18 @@ def test_authority_fades_only_where_the_damped_inverse_engages(trep: FsmsModel) 
     assert np.ptp(rates.base_decay_rate[far]) < 1e-3 * rates.base_decay_rate[0]
     assert np.all(np.diff(rates.base_decay_rate[~far]) < 0)
     assert rates.base_decay_rate[-1] < 0.2 * rates.base_decay_rate[0]
+
+
+def test_authority_in_runs_joined_is_the_authority_of_the_whole(trep: FsmsModel) -> None:
+    """The app asks the helper for the authority a few configurations at a time and joins the runs."""
+    thetas = np.column_stack((np.deg2rad([90.0, 60.0, 30.0, 10.0, 4.0]), np.deg2rad([0.0, 10.0, -20.0, 5.0, 0.0])))
+    whole = authority(loops_along(trep, "velocity", thetas), 24.0, 20.0)
+    runs = [authority(loops_along(trep, "velocity", thetas[a:b]), 24.0, 20.0) for a, b in ((0, 2), (2, 3), (3, 5))]
+    both = joined(runs)
+    for name in ("base_decay_rate", "arm_decay_rate", "base_damping_ratio", "stable", "coupling_norm"):
+        np.testing.assert_array_equal(getattr(both, name), getattr(whole, name))
+    with pytest.raises(ValueError, match="same gains"):
+        joined([runs[0], authority(loops_along(trep, "velocity", thetas[:1]), 10.0, 20.0)])
 
 
 def test_fig12_preset_decays_as_the_map_predicts_along_its_path(trep: FsmsModel) -> None:

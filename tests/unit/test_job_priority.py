@@ -40,7 +40,7 @@ def test_a_reach_request_overtakes_the_gain_explorers_sweep(monkeypatch: pytest.
 
     def watched(helper: jobs._Helper, name: str, request: bytes) -> bytes:
         started.append(name)
-        if name == "linear_loops" and started.count("linear_loops") == 2:
+        if name == "authority_at" and started.count("authority_at") == 2:
             mid_sweep.set()  # the sweep's second call holds the helper until the reach request waits
             deadline = time.monotonic() + 120.0
             while not helper.urgent_waiting and time.monotonic() < deadline:
@@ -61,7 +61,7 @@ def test_a_reach_request_overtakes_the_gain_explorers_sweep(monkeypatch: pytest.
         # Bound in explorer calls: none got the helper between the request and the reachable set ...
         assert started[asked:reach_at] == []
         # ... and the sweep was not starved: it went on after it, to its end.
-        assert started[reach_at + 1 :].count("linear_loops") == SWEEP // AUTHORITY_CHUNK - 2
+        assert started[reach_at + 1 :].count("authority_at") == SWEEP // AUTHORITY_CHUNK - 2
         (ready,) = [r for r in background.results(lambda: 0) if isinstance(r, ReachReady)]
         direct = build_reach_region(FsmsModel.from_key(FORCES_ONLY_KEY), theta0)
         np.testing.assert_array_equal(ready.region.points, direct.points)

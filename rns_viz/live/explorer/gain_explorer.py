@@ -32,7 +32,7 @@ from rns_viz.analysis import (
     LinearLoop,
     Locus,
     Modes,
-    authority,
+    joined,
     measure_kick,
     modes_of,
     root_locus,
@@ -95,7 +95,7 @@ class GainExplorer:
     def __init__(self) -> None:
         self.worker = Worker()
         self._loop: LinearLoop | None = None
-        self._loops: list[LinearLoop] | None = None
+        self._thetas: np.ndarray | None = None  # the configurations of the authority shown (K, n), rad
         self._key: tuple[str, LawKind, bytes] | None = None
         self.kick_t = math.nan  # s, the last kick (nan: no measurement due)
         self._kick_end = math.nan  # s
@@ -124,7 +124,7 @@ class GainExplorer:
             self._publish(**changes)
             self.retune(gains)
             return
-        self._key, self._loop, self._loops = key, None, None
+        self._key, self._loop, self._thetas = key, None, None
         paper = tuple((p.label, p.g_b, p.g_m) for p in PAPER_GAINS.get((model, law), ()))
         if gains != v.gains:
             changes["measured"] = None
@@ -150,11 +150,11 @@ class GainExplorer:
         self._submit_at(gains)
 
     def _submit_at(self, gains: Gains) -> None:
-        loop, loops = self._loop, self._loops
+        loop, thetas, key = self._loop, self._thetas, self._key
         if loop is not None:
-            self.worker.submit("at", (self._key, gains), lambda: _at(loop, gains))
-        if loops is not None:
-            self.worker.submit("authority", (self._key, gains), lambda: authority(loops, gains.g_b, gains.g_m))
+            self.worker.submit("at", (key, gains), lambda: _at(loop, gains))
+        if thetas is not None and key is not None:
+            self.worker.submit("authority", (key, gains), lambda: self._authority(key, thetas, gains))
 
     def along(self, model: str, thetas: np.ndarray, ee: np.ndarray) -> None:
         """The configurations (K, n) and end-effector points (K, 3) of model ``model``'s current path or set
@@ -164,20 +164,27 @@ class GainExplorer:
         pick = np.unique(np.linspace(0, len(thetas) - 1, min(AUTHORITY_POINTS, len(thetas))).astype(int))
         thetas, points = np.asarray(thetas, dtype=float)[pick], np.asarray(ee, dtype=float)[pick]
         key = self._key
-        _, law, _ = key
         gains = self.view.gains
-        self._loops = None
+        self._thetas = None
         self._publish(path_points=points, authority=None)
 
-        def job() -> tuple[list[LinearLoop], Authority] | None:
-            loops: list[LinearLoop] = []
-            for start in range(0, len(thetas), AUTHORITY_CHUNK):  # each call yields to waiting jobs
-                if self._key != key:
-                    return None  # stale: the model, law or configuration changed (collect drops it)
-                loops += jobs.call("linear_loops", model, law, thetas[start : start + AUTHORITY_CHUNK])
-            return loops, authority(loops, gains.g_b, gains.g_m)
+        def job() -> tuple[np.ndarray, Authority] | None:
+            found = self._authority(key, thetas, gains)
+            return None if found is None else (thetas, found)
 
         self.worker.submit("along", key, job)
+
+    def _authority(self, key: tuple[str, LawKind, bytes], thetas: np.ndarray, gains: Gains) -> Authority | None:
+        """The authority at ``gains`` over ``thetas``, computed in the helper a few configurations per call (each
+        call yields to waiting jobs); None once stale (the model, law or configuration changed)."""
+        model, law, _ = key
+        parts: list[Authority] = []
+        for start in range(0, len(thetas), AUTHORITY_CHUNK):
+            if self._key != key:
+                return None
+            chunk = thetas[start : start + AUTHORITY_CHUNK]
+            parts.append(jobs.call("authority_at", model, law, chunk, gains.g_b, gains.g_m))
+        return joined(parts)
 
     def kicked(self, t: float, duration: float, direction: tuple[float, ...] | None, suppress: bool) -> None:
         """A kick started at t (s), lasting ``duration`` s along ``direction`` (None: the first base
@@ -239,12 +246,12 @@ class GainExplorer:
             elif res.kind == "at" and res.tag[1] == gains:
                 self._publish(**_at_fields(res.value))
             elif res.kind == "along" and res.value is not None:  # None: abandoned when it went stale
-                self._loops, found = res.value
+                self._thetas, found = res.value
                 if (found.g_b, found.g_m) == (gains.g_b, gains.g_m):
                     self._publish(authority=found)
                 else:
                     self._submit_at(gains)
-            elif res.kind == "authority" and res.tag[1] == gains:
+            elif res.kind == "authority" and res.tag[1] == gains and res.value is not None:
                 self._publish(authority=res.value)
         return changed
 

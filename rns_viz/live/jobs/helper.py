@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from rns_viz.analysis import GainMap, LinearLoop, linearise, loops_along, map_of
+from rns_viz.analysis import Authority, GainMap, LinearLoop, authority, linearise, loops_along, map_of
 from rns_viz.control import LawKind
 from rns_viz.live.reach.region import ReachRegion, build_reach_region
 from rns_viz.model import FsmsModel
@@ -72,14 +72,36 @@ def loop_and_map(name: str, law: LawKind, theta: np.ndarray) -> tuple[LinearLoop
     return loop, map_of(loop)
 
 
+_loops_kept: OrderedDict[bytes, list[LinearLoop]] = OrderedDict()
+LOOPS_KEPT = 32  # runs of configurations whose loops the helper keeps (a path's 80 points are 8 runs)
+
+
 def linear_loops(name: str, law: LawKind, thetas: np.ndarray) -> list[LinearLoop]:
-    """One linearised loop per configuration (the gain explorer's authority along a path)."""
-    return loops_along(_model(name), law, thetas)
+    """One linearised loop per configuration (kept: the authority at new gains reuses them)."""
+    key = pickle.dumps((name, law, np.asarray(thetas, dtype=float)))
+    if key in _loops_kept:
+        _loops_kept.move_to_end(key)
+        return _loops_kept[key]
+    loops = _loops_kept[key] = loops_along(_model(name), law, thetas)
+    while len(_loops_kept) > LOOPS_KEPT:
+        _loops_kept.popitem(last=False)
+    return loops
 
 
-JOBS = {f.__name__: f for f in (family_curves, path_table, reach_region, linear_loop, loop_and_map, linear_loops)}
+def authority_at(name: str, law: LawKind, thetas: np.ndarray, g_b: float, g_m: float) -> Authority:
+    """The predicted decay rates at gains (g_b, g_m) (1/s) at configurations ``thetas`` (the gain explorer's
+    authority along a path): each configuration's kick response costs tens of ms on boom7, here and not in a
+    thread of the app's process, where it took turns with the simulation for the GIL."""
+    return authority(linear_loops(name, law, thetas), g_b, g_m)
+
+
+JOBS = {
+    f.__name__: f
+    for f in (family_curves, path_table, reach_region, linear_loop, loop_and_map, linear_loops, authority_at)
+}
 CACHE_BYTES = 64 * 2**20  # the helper's reply cache (ReplyCache); the largest reply, boom7's gain map, is 1.8 MB
-BACKGROUND_JOBS = frozenset({"linear_loop", "loop_and_map", "linear_loops"})  # the gain explorer's: they yield
+# the gain explorer's jobs: they yield to the others
+BACKGROUND_JOBS = frozenset({"linear_loop", "loop_and_map", "linear_loops", "authority_at"})
 
 
 class JobError(RuntimeError):
