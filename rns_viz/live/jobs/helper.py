@@ -19,13 +19,14 @@ arguments (and the model file), so a request answered before is answered again f
 
 from __future__ import annotations
 
+import os
 import pickle
 import sys
 import threading
 from collections import OrderedDict
 from collections.abc import Iterator
 from concurrent.futures import BrokenExecutor, Future, ProcessPoolExecutor
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from multiprocessing import active_children, get_context
 from multiprocessing.process import BaseProcess
 from typing import Any
@@ -106,6 +107,18 @@ BACKGROUND_JOBS = frozenset({"linear_loop", "loop_and_map", "linear_loops", "aut
 
 class JobError(RuntimeError):
     """A job failed, or the helper process died while running it (the message says which)."""
+
+
+HELPER_NICENESS = 10  # the helper's scheduling priority below the app's (Unix nice increment)
+
+
+def _below_the_loop() -> None:
+    """In the helper, at its start: run at a lower priority than the app's process. Its geometry can wait;
+    the simulation cannot (on two cores beside a browser that draws the scene in software, a helper at the
+    same priority recomputing boom7's gain map after every kick took the cycles the simulation needed)."""
+    if hasattr(os, "nice"):
+        with suppress(OSError):
+            os.nice(HELPER_NICENESS)
 
 
 def _compute(request: bytes) -> bytes:
@@ -220,7 +233,7 @@ class _Helper:
             self.close()
         if self.pool is not None:
             return self.pool.submit(_compute, request)
-        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"))
+        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn"), initializer=_below_the_loop)
         before = set(active_children())
         with _main_script_hidden():  # the helper is spawned by its first submit
             future = self.pool.submit(_compute, request)
