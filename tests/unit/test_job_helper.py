@@ -4,6 +4,7 @@ without a ``__main__`` guard can use it (the spawned helper does not run the scr
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import textwrap
@@ -35,6 +36,14 @@ def test_a_helper_that_died_while_idle_is_started_again_for_the_next_job(helper:
     process.join(10.0)
     assert len(helper.call("family_curves", "trep", 2)) == 2  # a new helper, the job done there
     assert helper.processes and helper.processes[0] is not process
+
+
+@pytest.mark.skipif(not hasattr(os, "getpriority"), reason="Unix scheduling priorities")
+def test_the_helper_runs_below_the_apps_priority(helper: jobs._Helper) -> None:
+    assert len(helper.call("family_curves", "trep", 1)) == 1
+    (process,) = helper.processes
+    ours = os.getpriority(os.PRIO_PROCESS, 0)
+    assert os.getpriority(os.PRIO_PROCESS, process.pid) == min(19, ours + jobs.HELPER_NICENESS)
 
 
 def test_a_helper_that_dies_during_a_job_fails_that_job_and_the_next_one_runs(
