@@ -4,8 +4,8 @@ Run on demand (Debian chromium needed for the browser scenario):
 
     python benchmarks/bench_app.py                     # TREP, 60 s per scenario
     python benchmarks/bench_app.py --model planar3r --seconds 20
-    python benchmarks/bench_app.py --teach --seconds 70  # issue 11: teaching views and recording, vs off
-    python benchmarks/bench_app.py --model trep2 --only browser     # dual arms (issue 13)
+    python benchmarks/bench_app.py --teach --seconds 70  # teaching views and recording, vs off
+    python benchmarks/bench_app.py --model trep2 --only browser     # dual arms
     python benchmarks/bench_app.py --model boom7 --only browser   # the 13-DOF spatial system
 
 The app runs in its own process (its CPU time is measured there, with time.process_time over all
@@ -26,7 +26,7 @@ one core (target <= 60 %), and the latency median / 90th percentile (target medi
 the machine's load average (the figures are only as good as the machine was quiet) and whether the
 native closed-loop step runs.
 
-``--teach`` (issue 11) runs the one-browser scenario twice in the same run: first a baseline with
+``--teach`` runs the one-browser scenario twice in the same run: first a baseline with
 every *Show in the scene* view off (no ghost, no arrows, trail or region) and the recorder switched
 off, then with all of them on and the recorder recording (as the app always does). Printed for both:
 the figures above and the server's resident memory; then the ring buffer's size for 60 s, the memory
@@ -239,12 +239,12 @@ def scenario_browser(model: str, seconds: float, teach: str | None = None) -> di
 
 
 def scenario_teach(model: str, seconds: float) -> None:
-    """The browser scenario without and with the teaching views and the recorder (issue 11)."""
+    """The browser scenario without and with the teaching views and the recorder."""
     off = scenario_browser(model, seconds, "off")
     on = scenario_browser(model, seconds, "on")
     if off is None or on is None:
         return
-    print("\n== recording (issue 11)")
+    print("\n== recording")
     print(f"  ring buffer for 60 s  {on['ring_mb']:6.1f} MB (target <= 50), holding {on['recorded_s']:.1f} s now")
     print(f"  resident memory       {on['rss_mb'] - off['rss_mb']:+6.1f} MB over the baseline (views + recorder)")
     print(f"  a 60 s replay         {on['replay_rss_mb'] - on['rss_mb']:+6.1f} MB more while it is shown")
@@ -320,7 +320,7 @@ def main() -> None:
     parser.add_argument("--model", default="trep", help="a bundled model (trep, planar3r, boom7, trep2) or .toml file")
     parser.add_argument("--seconds", type=float, default=60.0, help="measured seconds per scenario")
     parser.add_argument("--only", choices=("browser", "clients", "latency"), help="run one scenario")
-    parser.add_argument("--teach", action="store_true", help="issue 11: one browser, teaching views off then on")
+    parser.add_argument("--teach", action="store_true", help="one browser, teaching views off then on")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--teach-mode", choices=("on", "off"), help=argparse.SUPPRESS)
     args = parser.parse_args()

@@ -1,4 +1,4 @@
-"""Benchmark: what one frame of the app costs a software-rendered page, group by group (issue 14).
+"""Benchmark: what one frame of the app costs a software-rendered page, group by group.
 
     python benchmarks/bench_frame_cost.py                     # every group
     python benchmarks/bench_frame_cost.py --groups paths,grid  # some, e.g. twice: paths,grid,paths,grid

@@ -1,4 +1,4 @@
-"""Benchmark: the live app with the gain explorer in use (issue 10).
+"""Benchmark: the live app with the gain explorer in use.
 
     python benchmarks/bench_gain_ui.py --model trep --seconds 20
 

@@ -1,8 +1,8 @@
-"""Benchmark: a 60 x 60 gain map (issue 10) and one simulator step, this tree against another checkout.
+"""Benchmark: a 60 x 60 gain map and one simulator step, this tree against another checkout.
 
 Run on demand:  python benchmarks/bench_gains.py [OTHER_TREE] [--rounds 5] [--calls 7]
 
-e.g. against the commit the map's compute time is held to (issue 25):
+e.g. against an older commit:
     git worktree add /tmp/f9ec097 f9ec097 && python benchmarks/bench_gains.py /tmp/f9ec097
 
 Per model and law (TREP with (30), the 3R with (15), both with the other laws, and boom7 with (15)):

@@ -1,4 +1,4 @@
-"""Benchmark: does the page stay live on a weak machine and after a hidden tab? (issue 14)
+"""Benchmark: does the page stay live on a weak machine and after a hidden tab?
 
 Run on demand (Debian chromium, software WebGL, as on a machine without a GPU):
 
@@ -6,7 +6,7 @@ Run on demand (Debian chromium, software WebGL, as on a machine without a GPU):
     python benchmarks/bench_page.py --minutes 1 --hidden-minutes 0.5   # shortened
 
 Each scenario runs twice in the same run: with the per-client pacing of rns_viz.viz.server.page_pacing
-("paced") and without it ("unpaced", every page gets every update, as before issue 14). The app
+("paced") and without it ("unpaced", every page gets every update). The app
 runs in a child process (its real-time factor is not disturbed by the clients); TREP, default app.
 
 1. One software-rendered page, the base kicked from the page's Kick button every 10 s. Printed at

@@ -1,4 +1,4 @@
-"""Benchmark: what the always-on recorder (issue 11) costs the simulation loop, and its memory.
+"""Benchmark: what the always-on recorder costs the simulation loop, and its memory.
 
     python benchmarks/bench_recorder.py            # both models, 5 rounds of 3 s simulated each
 

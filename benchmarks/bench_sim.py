@@ -14,7 +14,7 @@ extension built the law and RK4 run in C++ (rns_viz.sim.native). Baselines:
   with the generated 7-DOF arm). It is also a check: its trajectory must equal the simulator's.
 - "pinocchio calls": crba + nonLinearEffects + 4 x aba alone, the floor of any step built on them.
 
-The Python step against another commit (e.g. issue 9's filing commit, checked out beside this one):
+The Python step against another commit (e.g. an older commit, checked out beside this one):
 ``python benchmarks/bench_step_vs.py OTHER_CHECKOUT`` (alternating subprocesses, wall and CPU time).
 
 trep2 (TREP with a compensating second arm, Sec. III-B) runs its own law, the CompensatingLaw tracking

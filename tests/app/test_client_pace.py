@@ -1,4 +1,4 @@
-"""Pacing of slow pages (issue 14) in the app, with protocol-level clients that answer the server's
+"""Pacing of slow pages in the app, with protocol-level clients that answer the server's
 questions late or not at all (the rule on its own: tests/unit/test_client_pace.py)."""
 
 from __future__ import annotations

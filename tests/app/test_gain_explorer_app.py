@@ -1,4 +1,4 @@
-"""The gain explorer in the app (issue 10), headless: clicks on the map sent as viser's scene click
+"""The gain explorer in the app, headless: clicks on the map sent as viser's scene click
 message by a protocol-level client, the operator lock, hostile clicks, and the authority colours."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 11, the app's teaching views: the ghost draws the shadow run (against the shadow simulation's
+"""The app's teaching views: the ghost draws the shadow run (against the shadow simulation's
 own state), the drawn n and force are the model's, the lesson panel, the reachable region's outline,
 the scene recording, and hostile values for the new controls (the reaction readout against Eq. (1) in a
 session: tests/session/test_teach.py).

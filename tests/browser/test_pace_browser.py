@@ -1,4 +1,4 @@
-"""Slow and hidden pages in a real headless Chromium (issue 14): a page whose CPU is throttled is told
+"""Slow and hidden pages in a real headless Chromium: a page whose CPU is throttled is told
 that its display is slowed, still operates the app, and loses the notice once it catches up; a tab
 hidden and frozen for a while answers again once shown and shows the current state. No timing
 thresholds: each step waits (generously) for what must happen."""

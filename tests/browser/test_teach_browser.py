@@ -1,4 +1,4 @@
-"""Issue 11 in a real headless Chromium: a student walks lesson 1 (kick the base, watch it swing) with
+"""The teaching views in a real headless Chromium: a student walks lesson 1 (kick the base, watch it swing) with
 the ghost of the shadow run shown. Screenshots: artifacts/lesson1_start.png, lesson1_done.png and
 ghost_trep.png (the base deflection drawn x50: the arm swings, the ghost with suppression has settled),
 picture_trep.png, saved by the app's Save picture button, and playback_trep.png: the last seconds of a

@@ -1,4 +1,4 @@
-"""Issue 11, record and replay: the last minute is always recorded; a replay shows exactly the recorded
+"""Record and replay: the last minute is always recorded; a replay shows exactly the recorded
 states while the simulation waits; exports read back exactly; bad replay input is refused.
 
 Oracles: the simulation's own step log and the snapshots the loop published while it ran (the

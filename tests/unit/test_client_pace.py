@@ -1,4 +1,4 @@
-"""Pacing of slow pages (issue 14), the rule on its own: the rate controller given answer times, and the
+"""Pacing of slow pages, the rule on its own: the rate controller given answer times, and the
 gate on one client's stream of windows (the app with protocol-level clients: tests/app/test_client_pace.py)."""
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ def test_fig8_and_fig10_are_drawn(tmp_path: Path) -> None:
 
 def test_every_paper_figure_has_a_drawer() -> None:
     paper = {"fig3", "fig4", "fig8", "fig10", "fig11", "fig12"}
-    assert set(FIGURES) == paper | {"gain_map_trep", "gain_map_planar3r"}  # and the gain maps (issue 10)
+    assert set(FIGURES) == paper | {"gain_map_trep", "gain_map_planar3r"}  # and the gain maps
 
 
 def test_cli_figures_rejects_unknown_names(tmp_path: Path) -> None:
