@@ -15,7 +15,7 @@ from __future__ import annotations
 import gc
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -278,13 +278,18 @@ def serve(
         model, host, port, password, lesson=lesson, models=models, pause_unwatched=pause_unwatched, present=present
     )
     print(f"rns_viz live app: http://{host}:{app.port}  (Ctrl+C to stop)")
+    serve_until_interrupted(app.stop)
+
+
+def serve_until_interrupted(stop: Callable[[], None]) -> None:
+    """Block this thread (the servers run in their own) until Ctrl+C, then ``stop()``."""
     try:
         while True:
             time.sleep(3600.0)
     except KeyboardInterrupt:
         pass
     finally:
-        app.stop()
+        stop()
 
 
-__all__ = ["TARGET_HANDLE", "RnsApp", "serve", "start_app"]
+__all__ = ["TARGET_HANDLE", "RnsApp", "serve", "serve_until_interrupted", "start_app"]

@@ -31,7 +31,7 @@ import viser._messages as viser_messages
 
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.clients.client_view import ClientView
-from rns_viz.viz.server.app import RnsApp
+from rns_viz.viz.server.app import RnsApp, serve_until_interrupted
 from rns_viz.viz.server.page_pacing import LateGate, gate_buffer
 from rns_viz.viz.server.presenter import WatchedSession, add_show_switch, add_watching_line, is_loopback, refuser
 from rns_viz.viz.server.visitor import CLOSED_TEXT, FULL_TEXT, Visitor
@@ -377,10 +377,4 @@ def serve_classroom(
     print(
         f"rns_viz, a simulation per visitor (at most {room.max_visitors}): http://{host}:{room.port}  (Ctrl+C to stop)"
     )
-    try:
-        while True:
-            time.sleep(3600.0)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        room.stop()
+    serve_until_interrupted(room.stop)
