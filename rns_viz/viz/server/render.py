@@ -7,6 +7,7 @@ live plots (15 Hz), the status text and readouts (5 Hz) and the settings shown i
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 import traceback
@@ -37,12 +38,8 @@ from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
 from rns_viz.viz.server.drawn_factor import DrawnFactor
+from rns_viz.viz.server.frame_rate import BEHIND_HOLD_S, PLOT_S, TEXT_S, frame_interval
 
-FRAME_S = 1.0 / 60.0  # scene updates at 60 Hz ...
-CROWD = 3  # ... and at 33 Hz from this many clients on (the server encodes every update once per client)
-CROWDED_FRAME_S = 1.0 / 33.0
-PLOT_S = 1.0 / 15.0  # live plots at 15 Hz (13 Hz when crowded)
-TEXT_S = 0.2  # status line and readouts at 5 Hz
 TARGET_HANDLE = "/base/target_handle"
 REACTION_LABEL = "arm reaction"
 KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
@@ -81,6 +78,7 @@ class Renderer:
         self._seen = _Seen()
         self.sync_settings(snap)
         self._stop = threading.Event()
+        self._behind_until = -math.inf  # perf_counter s until which frames come at CROWDED_FRAME_S
         self.thread = threading.Thread(target=self._loop, name="rns-render", daemon=True)
 
     def start(self) -> None:
@@ -167,7 +165,7 @@ class Renderer:
                     self.connections.panels.refresh()
             except Exception:  # drawing must never kill the app
                 traceback.print_exc()
-            next_time += CROWDED_FRAME_S if self.connections.client_count() >= CROWD else FRAME_S
+            next_time += frame_interval(self.connections.client_count(), time.perf_counter() < self._behind_until)
             delay = next_time - time.perf_counter()
             if delay < -0.1:
                 next_time = time.perf_counter()
@@ -175,6 +173,8 @@ class Renderer:
 
     def _frame(self, now: float) -> None:
         live = self.session.snapshot()
+        if live.behind:
+            self._behind_until = now + BEHIND_HOLD_S
         snap = replay_snapshot(live)  # during a replay: the recorded step at the playhead (settings: live's)
         if snap.settings.model != self.model_name:
             self._rebuild_for_model(live)
