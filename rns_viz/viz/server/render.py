@@ -7,7 +7,6 @@ live plots (15 Hz), the status text and readouts (5 Hz) and the settings shown i
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 import traceback
@@ -38,7 +37,7 @@ from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
 from rns_viz.viz.server.drawn_factor import DrawnFactor
-from rns_viz.viz.server.frame_rate import BEHIND_HOLD_S, PLOT_S, TEXT_S, frame_interval
+from rns_viz.viz.server.frame_rate import PLOT_S, TEXT_S, frame_interval
 
 TARGET_HANDLE = "/base/target_handle"
 REACTION_LABEL = "arm reaction"
@@ -78,7 +77,6 @@ class Renderer:
         self._seen = _Seen()
         self.sync_settings(snap)
         self._stop = threading.Event()
-        self._behind_until = -math.inf  # perf_counter s until which frames come at CROWDED_FRAME_S
         self.thread = threading.Thread(target=self._loop, name="rns-render", daemon=True)
 
     def start(self) -> None:
@@ -165,7 +163,7 @@ class Renderer:
                     self.connections.panels.refresh()
             except Exception:  # drawing must never kill the app
                 traceback.print_exc()
-            next_time += frame_interval(self.connections.client_count(), time.perf_counter() < self._behind_until)
+            next_time += frame_interval(self.connections.client_count())
             delay = next_time - time.perf_counter()
             if delay < -0.1:
                 next_time = time.perf_counter()
@@ -173,8 +171,6 @@ class Renderer:
 
     def _frame(self, now: float) -> None:
         live = self.session.snapshot()
-        if live.behind:
-            self._behind_until = now + BEHIND_HOLD_S
         snap = replay_snapshot(live)  # during a replay: the recorded step at the playhead (settings: live's)
         if snap.settings.model != self.model_name:
             self._rebuild_for_model(live)
