@@ -315,16 +315,17 @@ DRAG_STEP_S = 0.1  # s between the drag's ten mouse moves: a hand's pace (a whol
 
 
 def drag_handle_along_x(page: Page, app: RnsApp, pixels: float = 0.0, metres: float = 0.0) -> None:
-    """Press on the handle's x arrow (30 % of its length out), move along it by ``pixels`` on the screen or
-    by what moves the handle ``metres`` in the scene (the pixels per metre read off the camera the page
-    has), in about a second (not at the pace of the page's frames, which depends on how fast the machine
-    draws), release."""
-    x0, y0 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.3 * app.handle.scale])
-    x1, y1 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.6 * app.handle.scale])
-    length = max(float(np.hypot(x1 - x0, y1 - y0)), 1e-9)  # px for 0.3 handle scales along x
+    """Press on the handle's x arrow (60 % of its length out: beyond the plane handles, which reach 37 % and,
+    seen edge-on, are drawn over the arrow's first third), move along it by ``pixels`` on the screen or by
+    what moves the handle ``metres`` in the scene (the pixels per metre read off the camera the page has), in
+    about a second (not at the pace of the page's frames, which depends on how fast the machine draws),
+    release."""
+    x0, y0 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.6 * app.handle.scale])
+    x1, y1 = page.evaluate(PROJECT, [TARGET_HANDLE, 0.75 * app.handle.scale])
+    length = max(float(np.hypot(x1 - x0, y1 - y0)), 1e-9)  # px for 0.15 handle scales along x
     d = np.array([x1 - x0, y1 - y0]) / length
     if metres:
-        pixels = metres * length / (0.3 * app.handle.scale)
+        pixels = metres * length / (0.15 * app.handle.scale)
     page.mouse.move(x0, y0)
     page.mouse.down()
     for k in range(1, 11):
