@@ -72,8 +72,8 @@ def test_rank_overlay_toggle_draws_the_rank_deficient_poses() -> None:
         rank = app.renderer.rank
         assert not app.view.on("rank") and rank.overlay is None  # off by default, not computed
         app.view.boxes["rank"].value = True
-        wait_until(lambda: rank.shown and rank.overlay is not None, 10.0, "the rank overlay")
+        # the render thread computes the overlay, builds its nodes, then shows them
+        wait_until(lambda: rank._nodes and all(node.visible for node in rank._nodes), 10.0, "the rank overlay drawn")
         assert rank.overlay is not None and len(rank.overlay.poses) == 4
-        assert all(node.visible for node in rank._nodes)
     finally:
         app.stop()

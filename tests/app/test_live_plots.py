@@ -83,7 +83,9 @@ def test_legend_and_caption_name_the_two_runs_of_the_model_served_and_of_its_rep
         assert "suppression on" in plots.caption.content and "second arm" not in plots.caption.content
         app.session.switch_model("trep2")
         app.session.advance(0.01)
-        wait_until(lambda: plots.runs == "compensation", 20.0, "the trep2 panel")
+        # the render thread switches the runs, then writes the caption and shows the charts: wait for all of it
+        wait_until(lambda: plots.runs == "compensation" and "held still" in plots.caption.content, 20, "trep2's panel")
+        wait_until(lambda: plots.xb.visible and _legend(plots.xb)[0] == "compensation on", 20.0, "trep2's charts")
         shown = [c for c in plots.all_charts() if c.visible and c is not plots.error]
         assert len(shown) == 2 and all(_legend(c) == ("compensation on", "compensator held still") for c in shown)
         assert "held still" in plots.caption.content and "suppression on" not in plots.caption.content
@@ -101,7 +103,8 @@ def test_legend_and_caption_name_the_two_runs_of_the_model_served_and_of_its_rep
         assert plots.xb in shown and _legend(plots.xb) == ("compensation on", "compensator held still")
         app.session.switch_model("trep")
         app.session.advance(0.01)
-        wait_until(lambda: plots.runs == "suppression", 20.0, "the TREP panel")
+        wait_until(lambda: plots.runs == "suppression" and "suppression on" in plots.caption.content, 20, "TREP")
+        wait_until(lambda: plots.xb.visible and _legend(plots.xb)[0] == "suppression on", 20.0, "TREP's charts")
         assert _legend(plots.xb) == ("suppression on", "suppression off") and plots.xb.visible
         assert "suppression on" in plots.caption.content
     finally:
