@@ -211,9 +211,13 @@ def test_a_slow_page_gets_fewer_updates_of_its_own_simulation_and_a_fast_page_al
         assert fast_app.pace.state(fast_id)["hz"] == FULL_HZ
         wait_until(lambda: "Display slowed to" in (slow_app.pace.pages[slow_id].notice_text() or ""), 10.0, "told")
         fast_before, slow_before = len(fast.pose_times), len(slow.pose_times)
-        time.sleep(2.0)
+        drawn_before = slow_app.scene_updates
+        time.sleep(3.0)
         fast_poses, slow_poses = len(fast.pose_times) - fast_before, len(slow.pose_times) - slow_before
-        assert fast_poses > 2 * slow_poses > 0  # fewer, not none; the fast page is not held back
+        drawn = slow_app.scene_updates - drawn_before
+        # Fewer, not none: fewer than its own app drew and than the fast page got (on a quiet machine about a
+        # quarter; on a busy one the apps draw fewer frames for both, so no fixed ratio is asked).
+        assert 0 < slow_poses < min(drawn, fast_poses), (slow_poses, drawn, fast_poses)
         slow.close()
         fast.close()
     finally:
