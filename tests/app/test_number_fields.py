@@ -169,6 +169,19 @@ def test_negative_zero_and_small_exponents_are_the_numbers_they_name(
     assert g_b.value == 250.0 and g_b.max >= 250.0
 
 
+def g_b_applied(app: RnsApp, monkeypatch: pytest.MonkeyPatch) -> list[float]:
+    """The g_b of every gain change the panel sends the session from here on (the session still applies them)."""
+    applied: list[float] = []
+    original = app.session.set_gains
+
+    def spy(client_id, **changes):  # type: ignore[no-untyped-def]
+        applied.append(changes.get("g_b", math.nan))
+        original(client_id, **changes)
+
+    monkeypatch.setattr(app.session, "set_gains", spy)
+    return applied
+
+
 def test_text_is_read_when_the_typing_pauses_not_per_keystroke(
     typing_app: tuple[RnsApp, ProtocolClient, Told], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -177,14 +190,7 @@ def test_text_is_read_when_the_typing_pauses_not_per_keystroke(
     monkeypatch.setattr(number_field, "TYPING_PAUSE_S", 0.8)
     g_b = app.gui.gains["g_b"]
     old = app.controls.good(g_b)
-    applied: list[float] = []
-    original = app.session.set_gains
-
-    def spy(client_id, **changes):  # type: ignore[no-untyped-def]
-        applied.append(changes.get("g_b", math.nan))
-        original(client_id, **changes)
-
-    app.session.set_gains = spy  # type: ignore[method-assign]
+    applied = g_b_applied(app, monkeypatch)
     before = len(told)
     for text in ("1", "1e", "1e9"):
         client.set_value(gui_uuid(g_b.box), text)
@@ -211,14 +217,7 @@ def test_a_half_typed_number_is_not_refused_after_a_short_pause(
     monkeypatch.setattr(number_field, "TYPING_PAUSE_S", 0.3)
     monkeypatch.setattr(number_field, "UNFINISHED_PAUSE_S", 60.0)  # longer than this test: never reached
     g_b = app.gui.gains["g_b"]
-    applied: list[float] = []
-    original = app.session.set_gains
-
-    def spy(client_id, **changes):  # type: ignore[no-untyped-def]
-        applied.append(changes.get("g_b", math.nan))
-        original(client_id, **changes)
-
-    app.session.set_gains = spy  # type: ignore[method-assign]
+    applied = g_b_applied(app, monkeypatch)
     before = len(told)
     client.set_value(gui_uuid(g_b.box), "2e-")
     wait_until(lambda: g_b.typing(), 10.0, "the keystroke to arrive")
