@@ -58,6 +58,17 @@ def canvas_box(page) -> dict[str, float]:
     )
 
 
+def shown_size(page) -> tuple[int, int]:  # type: ignore[no-untyped-def]
+    """The 3-D canvas's size on the page (CSS px)."""
+    c = canvas_box(page)
+    return round(c["w"]), round(c["h"])
+
+
+def reported_size(client) -> tuple[int, int]:  # type: ignore[no-untyped-def]
+    """The canvas size the page's last camera message told the server."""
+    return int(client.camera.image_width), int(client.camera.image_height)
+
+
 def arm_on_screen(page, names: list[str], app: RnsApp) -> tuple[bool, float]:
     """Whether the arm's points lie in the visible canvas (and inside the viewport), and the span fraction."""
     px = arm_pixels(page, names, app)
@@ -87,7 +98,8 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
             client = next(iter(app.server.get_clients().values()))
             for w, h in SIZES:
                 page.set_viewport_size({"width": w, "height": h})
-                wait_until(lambda w=w: client.camera.image_width not in (0, w0) or w == w0, 10.0, "the new size")
+                # the server frames for the canvas size the page last reported: wait until that is the new canvas
+                wait_until(lambda: reported_size(client) == shown_size(page), 10.0, f"the page's size at {w}x{h}")
                 app.frame_robot(client)  # a page opened at this size is framed on its first camera message
                 # the page takes the new camera a frame or more later (slower on a busy machine): wait for the view
                 # the framing asks for, then read it
