@@ -63,9 +63,10 @@ def readable(axis: dict[str, Any] | None) -> bool:
 def assert_readable_ticks(page: Page, handle: Any, what: str) -> None:
     """The chart's y axis, once drawn for its new data, reads (:func:`readable`). The page draws new data and
     its axis in its own time, so a read may still see the axis of the data before (a flat run's lone "0"): the
-    test waits up to 10 s for a readable axis, and an axis that stays unreadable fails with what it shows."""
+    test waits up to 30 s for a readable axis (a software-rendered page on a busy machine draws a chart it has
+    just been switched to that late), and an axis that stays unreadable fails with what it shows."""
     try:
-        wait_until(lambda: readable(y_ticks(page, handle)), 10.0, f"readable y ticks of {what}")
+        wait_until(lambda: readable(y_ticks(page, handle)), 30.0, f"readable y ticks of {what}")
     except AssertionError:
         raise AssertionError((what, y_ticks(page, handle))) from None
 
