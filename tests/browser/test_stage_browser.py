@@ -7,6 +7,8 @@ Screenshots: artifacts/stage_<model>_<w>x<h>.png.
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 import pytest
 
@@ -83,6 +85,14 @@ def arm_on_screen(page, names: list[str], app: RnsApp) -> tuple[bool, float]:
     return inside, float(span)
 
 
+def at_rest(page, joints: list[str], app: RnsApp) -> bool:  # type: ignore[no-untyped-def]
+    """The arm is in view and where it was a few frames before (the camera has stopped moving)."""
+    before = arm_pixels(page, joints, app)
+    wait_for_frames(page, 3)
+    after = arm_pixels(page, joints, app)
+    return arm_on_screen(page, joints, app)[0] and bool(np.abs(after - before).max() < 0.5)
+
+
 @pytest.mark.parametrize("model", ["trep", "planar3r", "boom7", "trep2"])
 def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
     app = start_app(model, port=0, verbose=False)
@@ -104,7 +114,9 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                 want = app.scene.camera_pose(client.camera.fov, cw / ch, cw).position
                 taken = lambda want=want: np.allclose(client.camera.position, want, atol=1e-4)  # noqa: E731
                 wait_until(taken, 15.0, f"the framing at {w}x{h}")
-                wait_for_frames(page, 2)
+                # ... and once the page's camera has come to rest there (it may glide to a new pose)
+                with contextlib.suppress(AssertionError):  # the assertion below says what was seen
+                    wait_until(lambda: at_rest(page, joints, app), 15.0, f"the view at rest at {w}x{h}")
                 inside, span = arm_on_screen(page, joints, app)
                 print(f"\n{model} {w}x{h}: arm spans {span:.3f} of the view", end="")
                 least = PHONE_MIN_SPAN.get(model, MIN_SPAN) if w < 576 else MIN_SPAN
