@@ -116,6 +116,12 @@ def test_boom7_forces_only_drag_the_3d_target_over_the_reachable_set(boom_app: R
                         f"{e}: handle {np.round(app.handle.position, 4)} (was {np.round(handle0, 4)}), target "
                         f"{np.round(s.snapshot().target, 4)} (was {np.round(before, 4)}), notices {said}"
                     ) from e
+        # The arm's first motion shakes the base (its moments are not suppressed), drawn magnified. The handle
+        # hangs in the base's rest frame, so the page turns a mouse moved along the arrow into a target moved
+        # along x alone (under the drawn base it had moved by the base's motion since the press: 1-25 cm).
+        moved = lambda: np.asarray(s.snapshot().target) - before  # noqa: E731
+        wait_until(lambda: abs(moved()[0] - 0.02) < 4e-3, 10.0, "the target 2 cm along x")
+        assert np.abs(moved()[1:]).max() < 1e-3, moved()  # m: along the arrow only
         wait_until(
             lambda: np.linalg.norm(model.ee_position(s.snapshot().q[6:]) - hand0) > 0.01, 20.0, "the arm to follow"
         )

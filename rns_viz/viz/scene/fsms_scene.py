@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
+import pinocchio as pin
 import viser
 
 from rns_viz.model import FsmsModel
@@ -40,6 +41,10 @@ class FsmsScene:
     """Everything the FSMS app draws. Node names are class constants so tests can find them."""
 
     BASE = "/base"
+    # The base frame with the base at rest. The target handle hangs here, not under BASE: viser's page
+    # turns a drag into a pose in the handle's parent frame as that frame stands at each mouse move, so
+    # under the drawn (magnified) shaking base the handle would move by the base's motion since the press.
+    BASE_AT_REST = "/base_at_rest"
     PATHS = "/base/paths"
     REACHABLE = "/base/reachable"
     TARGET = "/base/target"
@@ -83,6 +88,9 @@ class FsmsScene:
         self._trail_lift = self._lift + np.array([0.0, 0.0, st.line_thickness])  # drawn over the path it follows
         self.robot = RobotMeshes(server, model, base_name=self.BASE, root=self.ROBOT)
         self.base_node = self.robot.base_node
+        rest = self.robot.rest_base_placement()
+        wxyz = pin.Quaternion(rest.rotation).coeffs()[[3, 0, 1, 2]]  # pinocchio stores x, y, z, w
+        scene.add_frame(self.BASE_AT_REST, show_axes=False, position=rest.translation, wxyz=wxyz)
         self.base_drawing = _make_base_drawing(server, model, st.base)
         self.paths = scene.add_line_segments(
             self.PATHS,

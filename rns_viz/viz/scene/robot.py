@@ -111,6 +111,13 @@ class RobotMeshes:
         """World placement of the last base joint after :meth:`pose` (the base frame)."""
         return self.data.oMi[self.model.m]
 
+    def rest_base_placement(self) -> pin.SE3:
+        """World placement of the last base joint with the base undeflected (every base coordinate at rest)."""
+        pm = self.model.pin_model
+        data = pm.createData()
+        pin.forwardKinematics(pm, data, pin.neutral(pm))
+        return data.oMi[self.model.m].copy()
+
     @property
     def base_node(self) -> viser.FrameHandle:
         """The node that follows the last base joint; children are in the base frame."""

@@ -39,7 +39,7 @@ from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
 from rns_viz.viz.server.drawn_factor import DrawnFactor
 from rns_viz.viz.server.frame_rate import PLOT_S, TEXT_S, frame_interval
 
-TARGET_HANDLE = "/base/target_handle"
+TARGET_HANDLE = f"{FsmsScene.BASE_AT_REST}/target_handle"  # at rest: the page drags it in that frame
 REACTION_LABEL = "arm reaction"
 KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
 # the names written in the scene that the *Labels* toggle hides (arrows' labels follow their arrows)
