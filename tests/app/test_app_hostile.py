@@ -99,11 +99,17 @@ def assert_finite_everywhere(app: RnsApp) -> None:
     for plot in (g.plot_xb, g.plot_L, g.plot_error):  # what was sent to the browsers
         assert all(np.all(np.isfinite(np.asarray(a, dtype=float))) for a in plot.data)
     assert np.all(np.isfinite(app.handle.position))
+    for field in number_fields(app):
+        assert math.isfinite(app.good(field)) and math.isfinite(field.value), field.label
+
+
+def number_fields(app: RnsApp) -> list[NumberField]:
+    g = app.gui
+    found = []
     for f in fields(g):
         value = getattr(g, f.name)
-        for field in value.values() if isinstance(value, dict) else [value]:
-            if isinstance(field, NumberField):
-                assert math.isfinite(app.good(field)) and math.isfinite(field.value), field.label
+        found += [x for x in (value.values() if isinstance(value, dict) else [value]) if isinstance(x, NumberField)]
+    return found
 
 
 actions = st.lists(
@@ -144,6 +150,10 @@ def test_hostile_values_to_every_control(
     # a refused drag's handle goes home at the next render frame (viser moved it to the client's value first):
     # wait for that frame, however busy the machine
     wait_until(lambda: np.all(np.isfinite(app.handle.position)), 10.0, "the render thread to send the handle home")
+    # a refused value sent to a box is written back once viser's thread pool has run its callback, which a busy
+    # machine may not have done yet (messages travel through the websocket): wait for every box to be written
+    boxes = number_fields(app)
+    wait_until(lambda: all(math.isfinite(b.value) for b in boxes), 10.0, "every refused box to be written back")
     assert_finite_everywhere(app)
 
 
