@@ -20,6 +20,7 @@ from rns_viz.model import FsmsModel
 from rns_viz.paths import ReactionlessPath
 from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.scene.boom_drawing import BoomDrawing
+from rns_viz.viz.scene.callouts import Callout, Callouts
 from rns_viz.viz.scene.framing import DEFAULT_ASPECT, DEFAULT_FOV, CameraPose, band_for, frame_points, framed_points
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
@@ -141,7 +142,9 @@ class FsmsScene:
             thickness=1.5 * st.line_thickness,
             visible=False,
         )
-        self.base_label = self._add_labels()
+        self.callouts = Callouts(server)  # labels placed off the arm each frame (the renderer adds its own)
+        self.base_callout = self._add_labels()
+        self.base_label = self.base_callout.label
         self.framed = framed_points(model)  # world points the camera frames
         self.also_framed: np.ndarray | None = None  # more of them while shown (the gain map's corners)
         self.set_initial_camera()
@@ -159,7 +162,7 @@ class FsmsScene:
         q_draw[:m] *= exaggeration
         with self.server.atomic():
             if exaggeration != self.exaggeration:  # the factor written is the factor drawn
-                self.base_label.text = base_label(exaggeration)
+                self.base_callout.text = self.base_label.text = base_label(exaggeration)
             self.q, self.exaggeration = np.asarray(q, dtype=float).copy(), exaggeration
             self.robot.pose(q_draw)
             if isinstance(self.base_drawing, BoomDrawing):
@@ -293,10 +296,14 @@ class FsmsScene:
         self.trail_node.points = polyline_segments(pts)
         self.trail_node.visible = self.show_trail
 
-    def _add_labels(self) -> viser.LabelHandle:
-        """The names written in the scene; returns the base's label (it writes the drawn factor)."""
+    def base_label_point(self) -> np.ndarray:
+        """World point the base's callout names (the style's point in the drawn base frame), m."""
+        return self.robot.base_placement().act(np.asarray(self.style.base_label, dtype=float))
+
+    def _add_labels(self) -> Callout:
+        """The names written in the scene; returns the base's callout (its label writes the drawn factor)."""
         scene, st = self.server.scene, self.style
-        label = scene.add_label("/base/label", base_label(1.0), position=st.base_label, anchor="bottom-center")
+        label = self.callouts.add("base", base_label(1.0))
         if isinstance(st.base, DoubleBeamStyle):
             scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
         elif isinstance(st.base, BoomStyle):

@@ -37,7 +37,7 @@ class GhostMeshes(RobotMeshes):
 
 
 class Ghost:
-    """The shadow system: arm meshes, base drawing and a label; ``update(q_shadow, ...)`` per frame."""
+    """The shadow system: arm meshes, base drawing and the words of its callout; ``update(q_shadow, ...)`` per frame."""
 
     ROOT = "/ghost"
     BASE = "/ghost/base"
@@ -50,15 +50,7 @@ class Ghost:
         assert root is not None
         self.root = root
         self.base_drawing = _ghost_base(server, model, style.base)
-        # At the ghost's hand (the end-effector frame on its joint's node), below and right of it: it moves with
-        # the ghost and stays off the arm's links, which all lie on the other side of the hand.
-        hand = model.pin_model.frames[model.ee_frame_id]
-        self.label = server.scene.add_label(
-            f"{self.robot.node_names[hand.parentJoint]}/ghost_label",
-            "ghost",
-            anchor="top-left",
-            position=tuple(float(v) for v in hand.placement.translation),
-        )
+        self.label_text = "ghost"  # what its callout says (drawn by the renderer's callouts, off the arm)
         self.q: np.ndarray | None = None  # the shadow's q as drawn (before exaggeration)
         self.exaggeration = float("nan")
         self.root.visible = False
@@ -71,8 +63,7 @@ class Ghost:
             return
         if not self.root.visible:
             self.root.visible = True
-        if self.label.text != label:
-            self.label.text = label
+        self.label_text = label
         if self.q is not None and np.array_equal(q, self.q) and exaggeration == self.exaggeration:
             return
         self.q, self.exaggeration = np.array(q, dtype=float), exaggeration

@@ -73,12 +73,17 @@ class RobotMeshes:
         self._world_posed = model.m  # joints 1..m are posed in the world, the rest relative to parents
         self._last: list[tuple[tuple[float, ...], tuple[float, ...]] | None] = [None] * len(self.frames)
         self.meshes: list[viser.SceneNodeHandle] = []
+        self._boxes: list[tuple[int, np.ndarray]] = []  # (joint, the 8 corners of a visual's box in its frame)
         carrying = {model.m}  # joints whose node carries visuals: the base node (and its children) always
         for link, geom_name, local in visuals:
             frame = pm.frames[pm.getFrameId(link)]
             local.apply_transform(frame.placement.homogeneous)
             node = self.node_names[frame.parentJoint]
             carrying.add(frame.parentJoint)
+            if frame.parentJoint >= model.m:  # the arm and its mount: what a label must not cover
+                (x0, y0, z0), (x1, y1, z1) = local.bounds
+                box = np.array([[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)])
+                self._boxes.append((frame.parentJoint, box))
             self.meshes.append(self._add_mesh(server, f"{node}/{link}_{geom_name}", local))
         # Base joints before the last are world-posed nodes of their own; one without visuals (boom7's
         # massless links between its six tip coordinates) shows nothing, so its pose is never sent.
@@ -122,6 +127,13 @@ class RobotMeshes:
     def base_node(self) -> viser.FrameHandle:
         """The node that follows the last base joint; children are in the base frame."""
         return self.frames[self.model.m - 1]
+
+    def link_corners(self) -> np.ndarray:
+        """World corners (L, 8, 3) of the box of every visual of the arm and its mount, as last posed, m."""
+        if not self._boxes:
+            return np.zeros((0, 8, 3))
+        placed = [self.data.oMi[j] for j, _ in self._boxes]
+        return np.stack([box @ M.rotation.T + M.translation for M, (_, box) in zip(placed, self._boxes, strict=True)])
 
     def ee_position(self, offset: np.ndarray | None = None) -> np.ndarray:
         """World position of the end effector (plus ``offset`` in the base frame) after :meth:`pose`, m."""

@@ -37,6 +37,7 @@ from rns_viz.viz.panels.path_words import PathWords
 from rns_viz.viz.panels.pictures import Pictures
 from rns_viz.viz.panels.rank_inset import RankInsetPanel
 from rns_viz.viz.panels.replay_panel import ReplayPanel
+from rns_viz.viz.scene.framing import NARROW_PX
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.view_toggles import first_look, make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
@@ -182,12 +183,17 @@ class RnsApp:
         back after a moment) keeps the simulation, its recording and, for the operator's page, control."""
         self.connections.client_joined(client)
         self.pace.client_joined(client)
-        framed = threading.Event()
+        framed_narrow: list[bool] = []  # whether the page was narrow when last framed (empty: not yet framed)
 
         @client.camera.on_update
-        def _(_: viser.CameraHandle) -> None:  # the page's first camera message tells its size: frame for it
-            if not framed.is_set() and client.camera.image_width > 0:
-                framed.set()
+        def _(_: viser.CameraHandle) -> None:
+            # The page's first camera message tells its size: frame for it. Framed again when the page turns
+            # narrow or wide (a phone rotated, a window narrowed): the panel then moves over or off the scene's
+            # lower part, where the arm would hide behind the sheet. Other moves of the view stay the user's.
+            width = client.camera.image_width
+            narrow = 0 < width < NARROW_PX
+            if width > 0 and framed_narrow[-1:] != [narrow]:
+                framed_narrow[:] = [narrow]
                 self.scene.frame_client(client)
 
         with self._visitors:

@@ -33,6 +33,7 @@ from rns_viz.viz.panels.model_words import kick_hint, target_text
 from rns_viz.viz.panels.panel_text import readouts_html, status_html
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
+from rns_viz.viz.scene.scene_callouts import SceneCallouts
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles, first_look
@@ -43,7 +44,7 @@ TARGET_HANDLE = f"{FsmsScene.BASE_AT_REST}/target_handle"  # at rest: the page d
 REACTION_LABEL = "arm reaction"
 KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
 # the names written in the scene that the *Labels* toggle hides (arrows' labels follow their arrows)
-LABELS = ("/base/label", "/beam/label", "/boom/label", "/spring/label", f"{TARGET_HANDLE}/label")
+LABELS = ("/beam/label", "/boom/label", "/spring/label")  # and the callouts: the base's, "drag me", the ghost's
 
 
 class Renderer:
@@ -119,9 +120,7 @@ class Renderer:
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
             self.view.boxes["rank"].visible = has_rank_inset(self.model)
-        self.server.scene.add_label(
-            f"{TARGET_HANDLE}/label", "drag me", position=(0.0, 0.0, 2.0 * st.marker_radius), anchor="bottom-left"
-        )
+        self.callouts = SceneCallouts(self.server, self.scene, self.teach.ghost, self.handle, self.connections)
         self.scene.set_target(snap.target)
         self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
 
@@ -193,6 +192,7 @@ class Renderer:
         if self.controls.take_handle_home_request():
             seen.target_version = -1
         self._draw_target(snap)
+        self.callouts.frame(now, self.view.on("labels"))
         for notice in self.session.pop_notices():
             self.connections.notify_by_id(notice.client, notice.title, notice.body, notice.level)
         if self.controls.apply_reverts() or snap.settings_version != seen.settings_version:
@@ -215,7 +215,6 @@ class Renderer:
                 handle = self.server.scene.get_handle_by_name(name)
                 if handle is not None:
                     handle.visible = labels
-            self.teach.ghost.label.visible = labels
         paths = view.on("paths")
         if paths != seen.paths:
             seen.paths = paths

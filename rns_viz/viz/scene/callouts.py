@@ -1,0 +1,194 @@
+"""Callouts: labels beside the points they name, each tied to its point by a leader line.
+
+Every LAYOUT_S the labels are placed (rns_viz.viz.scene.callout_layout) for the pages connected: candidate
+places are taken on the primary page (the operator's, else the first), each scored on every page by the
+cells of an arm (the robot's and the ghost's links) or another label it would cover; the first free place
+wins, the one in use is kept while it stays free (labels do not hop). Between layouts a label keeps its
+offset from its point in the world, so it follows a moving hand.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import viser
+import viser.transforms as vtf
+
+from rns_viz.viz.scene.callout_layout import (
+    GAP_PX,
+    Occupancy,
+    PageCamera,
+    Placement,
+    box_at,
+    candidates,
+    cost,
+    text_size,
+)
+from rns_viz.viz.scene.framing import band_for
+
+LAYOUT_S = 0.1  # s between layouts
+LEADER_COLOUR = (90, 90, 90)
+
+
+def page_camera(client: viser.ClientHandle) -> PageCamera | None:
+    """The camera a page last reported, or None before its first report."""
+    cam = client.camera
+    if cam.update_timestamp == 0.0 or cam.image_width <= 0 or cam.image_height <= 0:
+        return None
+    rotation = vtf.SO3(np.asarray(cam.wxyz, dtype=float)).as_matrix()
+    position, width, height = np.asarray(cam.position, dtype=float), cam.image_width, cam.image_height
+    bottom, top = band_for(width)  # NDC y: a phone's panel sheet covers the page below the band
+    shown = ((1.0 - top) / 2.0 * height, (1.0 - bottom) / 2.0 * height)
+    return PageCamera(position, rotation, float(cam.fov), width, height, shown)
+
+
+@dataclass
+class Callout:
+    """One label and its leader; the owner sets ``point`` (world, m), ``text`` and ``shown`` each frame."""
+
+    label: viser.LabelHandle
+    leader: viser.LineSegmentsHandle
+    text: str
+    point: np.ndarray | None = None
+    shown: bool = True
+    keep_clear: float = 0.0  # m: a cube of this half-size about the point is also kept clear (a handle)
+    placement: Placement | None = None
+    offset: np.ndarray = field(default_factory=lambda: np.zeros(3))  # label - point, world, m
+    sent: tuple[tuple[float, ...], str, bool] | None = None
+
+
+class Callouts:
+    """The scene's callouts under ``/callouts``; :meth:`frame` places and draws them."""
+
+    ROOT = "/callouts"
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        self.server = server
+        self.items: dict[str, Callout] = {}
+        self.next_layout = 0.0
+
+    def add(self, name: str, text: str, *, keep_clear: float = 0.0) -> Callout:
+        scene = self.server.scene
+        label = scene.add_label(f"{self.ROOT}/{name}/label", text, anchor="bottom-left", visible=False)
+        leader = scene.add_line_segments(
+            f"{self.ROOT}/{name}/leader",
+            np.zeros((1, 2, 3)),
+            LEADER_COLOUR,
+            thickness=1.5,
+            thickness_units="screen",
+            visible=False,
+        )
+        item = Callout(label, leader, text, keep_clear=keep_clear)
+        self.items[name] = item
+        return item
+
+    def frame(
+        self,
+        now: float,
+        pages: Sequence[PageCamera],
+        solids: Callable[[], np.ndarray],
+        labels_on: bool,
+    ) -> None:
+        """Place the callouts if it is time (``pages``: primary first; ``solids()``: (L, 8, 3) world corners
+        of what no label may cover) and send what changed."""
+        live = [c for c in self.items.values() if labels_on and c.shown and _finite(c.point)]
+        if live and pages and now >= self.next_layout:
+            self.next_layout = now + LAYOUT_S
+            self._layout(live, pages, solids())
+        for item in self.items.values():
+            self._draw(item, item in live)
+
+    def _layout(self, live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray) -> None:
+        occupied = []
+        for page in pages:
+            grid = Occupancy(page.width, page.height, page.shown)
+            for corners in page.project(solids)[0] if len(solids) else ():
+                grid.add_solid(corners)
+            for item in live:
+                if item.keep_clear > 0:
+                    grid.add_solid(page.project(_cube(item.point, item.keep_clear))[0])  # type: ignore[arg-type]
+            occupied.append(grid)
+        primary = pages[0]
+        for item in live:
+            point = np.asarray(item.point, dtype=float)
+            point_px, depth = primary.project(point)
+            if not (np.all(np.isfinite(point_px)) and depth > 0):
+                continue
+            size = text_size(item.text)
+            where = self._scored_elsewhere(point, point_px, float(depth), size, pages, occupied)
+            away = point_px - np.nanmean(primary.project(solids.reshape(-1, 3))[0], axis=0) if len(solids) else None
+            tried = [item.placement] if item.placement is not None else []
+            best, best_cost = item.placement, np.inf
+            for placement in tried + candidates(away):
+                total = where(placement)
+                if total < best_cost:
+                    best, best_cost = placement, total
+                if total == 0:
+                    break
+            assert best is not None
+            item.placement = best
+            label_world = primary.unproject(point_px + np.asarray(best.offset), float(depth))
+            item.offset = label_world - point
+            for page, grid in zip(pages, occupied, strict=True):  # the next callout keeps off this one
+                at = page.project(label_world)[0]
+                if np.all(np.isfinite(at)):
+                    grid.add_box(box_at(at, best.anchor, size), GAP_PX)
+
+    @staticmethod
+    def _scored_elsewhere(
+        point: np.ndarray,
+        point_px: np.ndarray,
+        depth: float,
+        size: tuple[float, float],
+        pages: Sequence[PageCamera],
+        occupied: list[Occupancy],
+    ) -> Callable[[Placement], float]:
+        """A placement's cost summed over the pages: on the primary as placed, on the others where its
+        world point projects (the same anchor)."""
+        primary = pages[0]
+
+        def total(placement: Placement) -> float:
+            score = cost(placement, point_px, size, occupied[0])
+            if len(pages) > 1:
+                label_world = primary.unproject(point_px + np.asarray(placement.offset), depth)
+                for page, grid in zip(pages[1:], occupied[1:], strict=True):
+                    at = page.project(label_world)[0]
+                    if np.all(np.isfinite(at)):
+                        score += cost(Placement((0.0, 0.0), placement.anchor), at, size, grid)
+            return score
+
+        return total
+
+    def _draw(self, item: Callout, live: bool) -> None:
+        if not live:
+            if item.sent is None or item.sent[2]:
+                item.label.visible = item.leader.visible = False
+                item.sent = ((), "", False)
+            return
+        point = np.asarray(item.point, dtype=float)
+        at = point + item.offset
+        anchor = item.placement.anchor if item.placement is not None else "bottom-left"
+        key = (tuple(np.round(np.r_[point, at], 5)), anchor, True)
+        if key == item.sent and item.label.text == item.text:
+            return
+        with self.server.atomic():
+            if item.label.text != item.text:
+                item.label.text = item.text
+            item.label.position = tuple(at)
+            if item.label.anchor != anchor:
+                item.label.anchor = anchor  # type: ignore[assignment]
+            item.leader.points = np.array([[point, at]])
+            if not item.label.visible:
+                item.label.visible = item.leader.visible = True
+        item.sent = key
+
+
+def _finite(point: np.ndarray | None) -> bool:
+    return point is not None and bool(np.all(np.isfinite(point)))
+
+
+def _cube(centre: np.ndarray | None, half: float) -> np.ndarray:
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    return np.asarray(centre, dtype=float) + half * signs

@@ -1,0 +1,64 @@
+"""The app's callouts: the base's name, "drag me" at the target handle and the ghost's name at its hand,
+placed off both arms."""
+
+from __future__ import annotations
+
+import numpy as np
+import viser
+
+from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.scene.callout_layout import PageCamera
+from rns_viz.viz.scene.callouts import page_camera
+from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.ghost import Ghost
+
+HANDLE_CLEAR = 0.45  # of the handle's scale: the cube about it that no label covers (its arrows and square)
+
+
+class SceneCallouts:
+    """Places and draws the callouts each frame for the pages connected (the operator's page first)."""
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        scene: FsmsScene,
+        ghost: Ghost,
+        handle: viser.TransformControlsHandle | None,
+        connections: Connections | None,
+    ) -> None:
+        """``handle`` None: no "drag me"; ``connections`` None (a recording's export): no pages, so every
+        label is drawn at its point."""
+        self.server, self.scene, self.ghost, self.handle, self.connections = server, scene, ghost, handle, connections
+        self.callouts = scene.callouts  # the base's callout is the scene's own
+        self.drag = (
+            None if handle is None else self.callouts.add("drag_me", "drag me", keep_clear=HANDLE_CLEAR * handle.scale)
+        )
+        self.ghost_name = self.callouts.add("ghost", ghost.label_text)
+        self.rest = scene.robot.rest_base_placement()  # the handle's parent frame (FsmsScene.BASE_AT_REST)
+
+    def frame(self, now: float, labels_on: bool) -> None:
+        self.scene.base_callout.point = self.scene.base_label_point()
+        if self.drag is not None and self.handle is not None:
+            self.drag.point = self.rest.act(np.asarray(self.handle.position, dtype=float))
+            self.drag.shown = bool(self.handle.visible)
+        self.ghost_name.shown = bool(self.ghost.root.visible)
+        self.ghost_name.text = self.ghost.label_text
+        self.ghost_name.point = self.ghost.robot.ee_position() if self.ghost_name.shown else None
+        self.callouts.frame(now, self.pages(), self.solids, labels_on)
+
+    def pages(self) -> list[PageCamera]:
+        """The pages' cameras, the operator's first (then by connection order)."""
+        if self.connections is None:
+            return []
+        allowed = self.connections.allowed
+        clients = sorted(self.server.get_clients().items())
+        clients.sort(key=lambda item: not allowed(item[1]))
+        cameras = (page_camera(client) for _, client in clients)
+        return [cam for cam in cameras if cam is not None]
+
+    def solids(self) -> np.ndarray:
+        """World corners of every visual box of the robot's arm, and of the ghost's when it is shown."""
+        parts = [self.scene.robot.link_corners()]
+        if self.ghost.root.visible:
+            parts.append(self.ghost.robot.link_corners())
+        return np.concatenate(parts)

@@ -1,0 +1,140 @@
+"""Labels never hide the arm nor each other, read from the rendered pixels of a real Chromium.
+
+With the simulation paused and the page's view at rest: a label's pixels are the frame with it drawn minus
+the frame without it; the arm's pixels the frame with the robot's meshes minus the frame without them (all
+labels hidden). At a projector's, a laptop's and a phone's size, for the models whose labels sat over the
+hand (boom7: "drag me" 37 % and the ghost's 68 % of their pixels over the arm, before the callouts), and
+TREP and trep2. Pictures: artifacts/callouts_<model>_<w>x<h>.png.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import time
+
+import numpy as np
+import pytest
+import viser
+from PIL import Image
+
+from rns_viz.viz.server.app import RnsApp, start_app
+from tests.browser.test_stage_browser import at_rest, canvas_box, reported_size, shown_size
+from tests.support.browser import (
+    browser_page,
+    dismiss_notifications,
+    screenshot,
+    wait_for_frames,
+    wait_for_nodes,
+    wait_until,
+)
+
+SIZES = ((1920, 1080), (1366, 768), (390, 844))
+CHANGED = 30  # a pixel differs between two frames when its R + G + B differ by more than this
+# A label's pixels over the arm: at most this fraction (its anti-aliased rim may touch a link's edge)
+OVER_ARM = 0.02
+
+
+def shown_labels(app: RnsApp) -> dict[str, viser.LabelHandle]:
+    """Every label drawn in the scene with words (the gain map's are off in the first look)."""
+    nodes = app.server.scene._handle_from_node_name  # viser keeps no public list of its nodes
+    return {
+        name: h
+        for name, h in nodes.items()
+        if isinstance(h, viser.LabelHandle) and h.visible and h.text.strip() and not name.startswith("/gain_map")
+    }
+
+
+def canvas_pixels(page) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """The 3-D canvas's visible part, RGB ints (h, w, 3), once two frames half a second apart are the same
+    (the page's camera glides to a new view for a while, by less than a pixel a frame at its end)."""
+
+    def grab() -> np.ndarray:
+        wait_for_frames(page, 4)
+        c = canvas_box(page)
+        vw, vh = page.viewport_size["width"], page.viewport_size["height"]
+        x0, y0 = int(max(c["x"], 0)), int(max(c["y"], 0))
+        x1, y1 = int(min(c["x"] + c["w"], vw)), int(min(c["y"] + c["h"], vh))
+        img = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
+        return img[y0:y1, x0:x1]
+
+    before = grab()
+    deadline = time.monotonic() + 20.0
+    while True:
+        time.sleep(0.5)
+        now = grab()
+        if changed(before, now).sum() == 0 or time.monotonic() > deadline:
+            return now
+        before = now
+
+
+def changed(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.abs(a - b).sum(axis=2) > CHANGED
+
+
+def pixels_of(page, nodes: list) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """The pixels that change when ``nodes`` (hidden) are shown: frame shown minus frame hidden, taken again
+    while the frame hidden before and after differ (the page's camera still settling by a pixel)."""
+    for _ in range(6):
+        before = canvas_pixels(page)
+        for node in nodes:
+            node.visible = True
+        shown = canvas_pixels(page)
+        for node in nodes:
+            node.visible = False
+        if not changed(before, canvas_pixels(page)).any():
+            return changed(shown, before)
+    raise AssertionError("the view kept changing while nodes were shown and hidden")
+
+
+@pytest.mark.parametrize("model", ["boom7", "trep", "trep2"])
+def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
+    app = start_app(model, port=0, verbose=False)
+    try:
+        joints = [name for name in app.scene.robot.node_names[app.model.m :] if name]
+        with browser_page(app.server, width=SIZES[0][0], height=SIZES[0][1], draw=True) as page:
+            wait_for_nodes(page, set(joints))
+            dismiss_notifications(page)
+            client = next(iter(app.server.get_clients().values()))
+            app.session.pause()
+            # the overlays a background job computes (boom7's and trep2's reachable set) drawn before any picture
+            drawn = lambda: app.renderer._seen.overlay_version == app.session.snapshot().overlay_version  # noqa: E731
+            wait_until(
+                lambda: app.session.overlays().model == app.session.snapshot().settings.model and drawn(),
+                60.0,
+                "the overlays drawn",
+            )
+            for w, h in SIZES:
+                page.set_viewport_size({"width": w, "height": h})
+                wait_until(lambda w=w: shown_size(page)[0] <= w, 10.0, f"the canvas laid out at {w}x{h}")
+                wait_until(lambda: reported_size(client) == shown_size(page), 10.0, f"the page's size at {w}x{h}")
+                app.frame_robot(client)
+                with contextlib.suppress(AssertionError):  # a view still gliding shows in the pixels below
+                    wait_until(lambda: at_rest(page, joints, app), 15.0, f"the view at rest at {w}x{h}")
+                time.sleep(0.3)  # a layout (every 0.1 s) for this view
+                labels = shown_labels(app)
+                assert {"/callouts/base/label", "/callouts/drag_me/label", "/callouts/ghost/label"} <= set(labels)
+                screenshot(page, f"callouts_{model}_{w}x{h}")
+                for handle in labels.values():
+                    handle.visible = False
+                meshes = app.scene.robot.meshes
+                for mesh in meshes:
+                    mesh.visible = False
+                arm = pixels_of(page, meshes)
+                for mesh in meshes:
+                    mesh.visible = True
+                assert arm.sum() > 1000, "the arm is drawn"
+                masks = {handle.text: pixels_of(page, [handle]) for handle in labels.values()}
+                for handle in labels.values():
+                    handle.visible = True
+                for text, mask in masks.items():
+                    over = (mask & arm).sum() / max(mask.sum(), 1)
+                    print(f"\n{model} {w}x{h} {text!r}: {mask.sum()} px, {over:.1%} over the arm", end="")
+                    assert over <= OVER_ARM, (w, h, text, over)
+                texts = list(masks)
+                for i, a in enumerate(texts):
+                    for b in texts[i + 1 :]:
+                        assert not (masks[a] & masks[b]).any(), (w, h, a, b)
+
+    finally:
+        app.stop()
