@@ -107,11 +107,14 @@ def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
             for w, h in SIZES:
                 page.set_viewport_size({"width": w, "height": h})
                 wait_until(lambda w=w: shown_size(page)[0] <= w, 10.0, f"the canvas laid out at {w}x{h}")
-                wait_until(lambda: reported_size(client) == shown_size(page), 10.0, f"the page's size at {w}x{h}")
+                try:
+                    wait_until(lambda: reported_size(client) == shown_size(page), 20.0, f"the page's size at {w}x{h}")
+                except AssertionError as e:
+                    raise AssertionError(f"{e}: reported {reported_size(client)}, shown {shown_size(page)}") from e
                 app.frame_robot(client)
                 with contextlib.suppress(AssertionError):  # a view still gliding shows in the pixels below
                     wait_until(lambda: at_rest(page, joints, app), 15.0, f"the view at rest at {w}x{h}")
-                time.sleep(0.3)  # a layout (every 0.1 s) for this view
+                time.sleep(0.5)  # a layout (every 0.2 s) for this view
                 labels = shown_labels(app)
                 assert {"/callouts/base/label", "/callouts/drag_me/label", "/callouts/ghost/label"} <= set(labels)
                 screenshot(page, f"callouts_{model}_{w}x{h}")

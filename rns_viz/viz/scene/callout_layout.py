@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-CELL_PX = 4  # the grid's cell: a link's filled hull is grown by half a cell's diagonal, so none slips between
+CELL_PX = 6  # the grid's cell: a link's filled hull is grown by half a cell's diagonal, so none slips between
 CHAR_PX = 7.4  # px per character of a label's text, and its box's padding and height (viser's labels at
 PAD_PX = 12.0  # font_screen_scale 1, as measured on rendered pages; over-estimated a little on purpose)
 HEIGHT_PX = 22.0
@@ -109,7 +109,6 @@ class Occupancy:
         self.width, self.height = width, height
         self.top, self.bottom = shown if shown is not None else (0.0, float(height))
         self.cells = np.zeros((max(1, math.ceil(height / CELL_PX)), max(1, math.ceil(width / CELL_PX))), dtype=bool)
-        self._sums: np.ndarray | None = None
 
     def add_solid(self, corners_px: np.ndarray) -> None:
         """Take the cells under the convex hull of one solid's projected corners (k, 2) (nan: behind the page)."""
@@ -136,20 +135,15 @@ class Occupancy:
                 length = float(np.hypot(*edge)) or 1.0
                 inside &= (edge[0] * (Y - a[1]) - edge[1] * (X - a[0])) / length >= -grow
         self.cells[lo[1] : hi[1], lo[0] : hi[0]] |= inside
-        self._sums = None
 
     def add_box(self, box: np.ndarray, grow: float = 0.0) -> None:
         i0, j0, i1, j1 = self._index(np.asarray(box, dtype=float) + np.array([-grow, -grow, grow, grow]))
         self.cells[j0:j1, i0:i1] = True
-        self._sums = None
 
     def taken(self, box: np.ndarray) -> int:
         """How many taken cells the box (x0, y0, x1, y1) px covers."""
-        if self._sums is None:
-            self._sums = np.pad(self.cells.cumsum(0).cumsum(1), ((1, 0), (1, 0)))
         i0, j0, i1, j1 = self._index(box)
-        s = self._sums
-        return int(s[j1, i1] - s[j0, i1] - s[j1, i0] + s[j0, i0])
+        return int(np.count_nonzero(self.cells[j0:j1, i0:i1]))
 
     def inside(self, box: np.ndarray) -> bool:
         x0, y0, x1, y1 = box

@@ -28,7 +28,8 @@ from rns_viz.viz.scene.callout_layout import (
 )
 from rns_viz.viz.scene.framing import band_for
 
-LAYOUT_S = 0.1  # s between layouts
+LAYOUT_S = 0.2  # s between layouts (while the view or the arm moves; none while both stand still)
+STILL_PX = 1.0  # a layout is skipped while no page's projected point or solid moved more than this
 LEADER_COLOUR = (90, 90, 90)
 
 
@@ -68,6 +69,7 @@ class Callouts:
         self.server = server
         self.items: dict[str, Callout] = {}
         self.next_layout = 0.0
+        self._laid_out: tuple[list[str], list[np.ndarray]] | None = None  # what the last layout saw
 
     def add(self, name: str, text: str, *, keep_clear: float = 0.0) -> Callout:
         scene = self.server.scene
@@ -96,9 +98,33 @@ class Callouts:
         live = [c for c in self.items.values() if labels_on and c.shown and _finite(c.point)]
         if live and pages and now >= self.next_layout:
             self.next_layout = now + LAYOUT_S
-            self._layout(live, pages, solids())
+            corners = solids()
+            seen = self._seen(live, pages, corners)
+            if not self._same(seen):
+                self._laid_out = seen
+                self._layout(live, pages, corners)
         for item in self.items.values():
             self._draw(item, item in live)
+
+    @staticmethod
+    def _seen(
+        live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray
+    ) -> tuple[list[str], list[np.ndarray]]:
+        """What a layout depends on: the callouts' words, and on each page the points and solids' pixels."""
+        points = np.array([item.point for item in live], dtype=float)
+        world = np.concatenate([points, solids.reshape(-1, 3)])
+        return [item.text for item in live], [
+            np.r_[page.width, page.height, page.project(world)[0].ravel()] for page in pages
+        ]
+
+    def _same(self, seen: tuple[list[str], list[np.ndarray]]) -> bool:
+        last = self._laid_out
+        if last is None or last[0] != seen[0] or len(last[1]) != len(seen[1]):
+            return False
+        return all(
+            a.shape == b.shape and bool(np.all(np.abs(np.nan_to_num(a - b, nan=np.inf)) <= STILL_PX))
+            for a, b in zip(last[1], seen[1], strict=True)
+        )
 
     def _layout(self, live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray) -> None:
         occupied = []

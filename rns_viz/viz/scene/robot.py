@@ -129,11 +129,19 @@ class RobotMeshes:
         return self.frames[self.model.m - 1]
 
     def link_corners(self) -> np.ndarray:
-        """World corners (L, 8, 3) of the box of every visual of the arm and its mount, as last posed, m."""
+        """World corners (J, 8 k, 3) of the boxes of the visuals each joint of the arm and its mount carries (k
+        boxes, repeated to the largest k), as last posed, m: one solid per link."""
         if not self._boxes:
             return np.zeros((0, 8, 3))
-        placed = [self.data.oMi[j] for j, _ in self._boxes]
-        return np.stack([box @ M.rotation.T + M.translation for M, (_, box) in zip(placed, self._boxes, strict=True)])
+        joints = sorted({j for j, _ in self._boxes})
+        per_joint = [np.concatenate([box for j, box in self._boxes if j == joint]) for joint in joints]
+        most = max(len(c) for c in per_joint)
+        out = np.empty((len(joints), most, 3))
+        for row, (joint, corners) in enumerate(zip(joints, per_joint, strict=True)):
+            M = self.data.oMi[joint]
+            world = corners @ M.rotation.T + M.translation
+            out[row] = np.concatenate([world, np.repeat(world[-1:], most - len(world), axis=0)])
+        return out
 
     def ee_position(self, offset: np.ndarray | None = None) -> np.ndarray:
         """World position of the end effector (plus ``offset`` in the base frame) after :meth:`pose`, m."""
