@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-CELL_PX = 6  # the grid's cell: a link's filled hull is grown by half a cell's diagonal, so none slips between
+CELL_PX = 8  # the grid's cell: a link's filled hull is grown by half a cell's diagonal, so none slips between
 CHAR_PX = 7.4  # px per character of a label's text, and its box's padding and height (viser's labels at
 PAD_PX = 12.0  # font_screen_scale 1, as measured on rendered pages; over-estimated a little on purpose)
 HEIGHT_PX = 22.0

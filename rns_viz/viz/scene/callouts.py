@@ -28,7 +28,7 @@ from rns_viz.viz.scene.callout_layout import (
 )
 from rns_viz.viz.scene.framing import band_for
 
-LAYOUT_S = 0.2  # s between layouts (while the view or the arm moves; none while both stand still)
+LAYOUT_S = 0.25  # s between layouts (while the view or the arm moves; none while both stand still)
 STILL_PX = 1.0  # a layout is skipped while no page's projected point or solid moved more than this
 LEADER_COLOUR = (90, 90, 90)
 
@@ -199,15 +199,15 @@ class Callouts:
         key = (tuple(np.round(np.r_[point, at], 5)), anchor, True)
         if key == item.sent and item.label.text == item.text:
             return
-        with self.server.atomic():
-            if item.label.text != item.text:
-                item.label.text = item.text
-            item.label.position = tuple(at)
-            if item.label.anchor != anchor:
-                item.label.anchor = anchor  # type: ignore[assignment]
-            item.leader.points = np.array([[point, at]])
-            if not item.label.visible:
-                item.label.visible = item.leader.visible = True
+        # no atomic() of its own: the renderer's frame is one (a nested one still wakes viser's loop at its end)
+        if item.label.text != item.text:
+            item.label.text = item.text
+        item.label.position = tuple(at)
+        if item.label.anchor != anchor:
+            item.label.anchor = anchor  # type: ignore[assignment]
+        item.leader.points = np.array([[point, at]])
+        if not item.label.visible:
+            item.label.visible = item.leader.visible = True
         item.sent = key
 
 
