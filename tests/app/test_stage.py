@@ -138,7 +138,7 @@ def test_the_app_starts_with_its_models_row_and_toggles_hide_and_show_nodes(mode
 def check_first_look_and_toggles(app: RnsApp, model: str) -> None:
     view, server = app.view, app.server
     assert {n for n, box in view.boxes.items() if box.value} == defaults_for(model).shown
-    label = server.scene.get_handle_by_name("/callouts/base/label")
+    label = server.scene.get_handle_by_name("/base/callout_base")
     assert label is not None
     settle(app)
     wait_until(lambda: label.visible, 5.0, "the base label shown")

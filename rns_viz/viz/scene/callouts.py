@@ -1,5 +1,8 @@
 """Callouts: labels beside the points they name, each tied to its point by a leader line.
 
+A callout's nodes hang under the scene node its point moves with (the drawn base, the ghost's hand, the
+handle's frame), so they follow it with nothing sent per frame; only a new place is sent.
+
 Every LAYOUT_S the labels are placed (rns_viz.viz.scene.callout_layout) for the pages connected: candidate
 places are taken on the primary page (the operator's, else the first), each scored on every page by the
 cells of an arm (the robot's and the ghost's links) or another label it would cover; the first free place
@@ -47,23 +50,30 @@ def page_camera(client: viser.ClientHandle) -> PageCamera | None:
 
 @dataclass
 class Callout:
-    """One label and its leader; the owner sets ``point`` (world, m), ``text`` and ``shown`` each frame."""
+    """One label and its leader under a parent node; the owner calls :meth:`attach` and sets ``text`` and
+    ``shown`` each frame."""
 
     label: viser.LabelHandle
     leader: viser.LineSegmentsHandle
     text: str
-    point: np.ndarray | None = None
+    point: np.ndarray | None = None  # world, m
     shown: bool = True
     keep_clear: float = 0.0  # m: a cube of this half-size about the point is also kept clear (a handle)
     placement: Placement | None = None
     offset: np.ndarray = field(default_factory=lambda: np.zeros(3))  # label - point, world, m
+    local: np.ndarray = field(default_factory=lambda: np.zeros(3))  # the point in the parent's frame, m
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))  # the parent's, world from parent
+    offset_local: np.ndarray = field(default_factory=lambda: np.zeros(3))  # ``offset`` in the parent's frame
     sent: tuple[tuple[float, ...], str, bool] | None = None
+
+    def attach(self, rotation: np.ndarray, translation: np.ndarray, local: np.ndarray) -> None:
+        """The parent's world pose now and the point in its frame (m)."""
+        self.rotation, self.local = np.asarray(rotation, dtype=float), np.asarray(local, dtype=float)
+        self.point = self.rotation @ self.local + np.asarray(translation, dtype=float)
 
 
 class Callouts:
-    """The scene's callouts under ``/callouts``; :meth:`frame` places and draws them."""
-
-    ROOT = "/callouts"
+    """The scene's callouts; :meth:`frame` places and draws them."""
 
     def __init__(self, server: viser.ViserServer) -> None:
         self.server = server
@@ -71,11 +81,12 @@ class Callouts:
         self.next_layout = 0.0
         self._laid_out: tuple[list[str], list[np.ndarray]] | None = None  # what the last layout saw
 
-    def add(self, name: str, text: str, *, keep_clear: float = 0.0) -> Callout:
+    def add(self, name: str, text: str, *, parent: str = "", keep_clear: float = 0.0) -> Callout:
+        """A callout whose nodes hang under the scene node ``parent`` ('' for the world)."""
         scene = self.server.scene
-        label = scene.add_label(f"{self.ROOT}/{name}/label", text, anchor="bottom-left", visible=False)
+        label = scene.add_label(f"{parent}/callout_{name}", text, anchor="bottom-left", visible=False)
         leader = scene.add_line_segments(
-            f"{self.ROOT}/{name}/leader",
+            f"{parent}/callout_{name}_leader",
             np.zeros((1, 2, 3)),
             LEADER_COLOUR,
             thickness=1.5,
@@ -157,6 +168,7 @@ class Callouts:
             item.placement = best
             label_world = primary.unproject(point_px + np.asarray(best.offset), float(depth))
             item.offset = label_world - point
+            item.offset_local = item.rotation.T @ item.offset
             for page, grid in zip(pages, occupied, strict=True):  # the next callout keeps off this one
                 at = page.project(label_world)[0]
                 if np.all(np.isfinite(at)):
@@ -193,19 +205,17 @@ class Callouts:
                 item.label.visible = item.leader.visible = False
                 item.sent = ((), "", False)
             return
-        point = np.asarray(item.point, dtype=float)
-        at = point + item.offset
+        local, at = item.local, item.local + item.offset_local  # in the parent's frame: they move with it
         anchor = item.placement.anchor if item.placement is not None else "bottom-left"
-        key = (tuple(np.round(np.r_[point, at], 5)), anchor, True)
+        key = (tuple(np.round(np.r_[local, at], 5)), anchor, True)
         if key == item.sent and item.label.text == item.text:
             return
-        # no atomic() of its own: the renderer's frame is one (a nested one still wakes viser's loop at its end)
         if item.label.text != item.text:
             item.label.text = item.text
         item.label.position = tuple(at)
         if item.label.anchor != anchor:
             item.label.anchor = anchor  # type: ignore[assignment]
-        item.leader.points = np.array([[point, at]])
+        item.leader.points = np.array([[local, at]])
         if not item.label.visible:
             item.label.visible = item.leader.visible = True
         item.sent = key

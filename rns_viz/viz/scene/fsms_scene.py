@@ -296,14 +296,15 @@ class FsmsScene:
         self.trail_node.points = polyline_segments(pts)
         self.trail_node.visible = self.show_trail
 
-    def base_label_point(self) -> np.ndarray:
-        """World point the base's callout names (the style's point in the drawn base frame), m."""
-        return self.robot.base_placement().act(np.asarray(self.style.base_label, dtype=float))
+    def attach_base_callout(self) -> None:
+        """Tie the base's callout to the drawn base frame as last posed (its point: the style's, in that frame)."""
+        base = self.robot.base_placement()
+        self.base_callout.attach(base.rotation, base.translation, np.asarray(self.style.base_label, dtype=float))
 
     def _add_labels(self) -> Callout:
         """The names written in the scene; returns the base's callout (its label writes the drawn factor)."""
         scene, st = self.server.scene, self.style
-        label = self.callouts.add("base", base_label(1.0))
+        label = self.callouts.add("base", base_label(1.0), parent=self.BASE)
         if isinstance(st.base, DoubleBeamStyle):
             scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
         elif isinstance(st.base, BoomStyle):

@@ -30,20 +30,26 @@ class SceneCallouts:
         label is drawn at its point."""
         self.server, self.scene, self.ghost, self.handle, self.connections = server, scene, ghost, handle, connections
         self.callouts = scene.callouts  # the base's callout is the scene's own
-        self.drag = (
-            None if handle is None else self.callouts.add("drag_me", "drag me", keep_clear=HANDLE_CLEAR * handle.scale)
-        )
-        self.ghost_name = self.callouts.add("ghost", ghost.label_text)
+        self.drag = None
+        if handle is not None:  # its frame: the handle's parent (FsmsScene.BASE_AT_REST), its point: the handle
+            clear = HANDLE_CLEAR * handle.scale
+            self.drag = self.callouts.add("drag_me", "drag me", parent=FsmsScene.BASE_AT_REST, keep_clear=clear)
+        model = ghost.model
+        hand = model.pin_model.frames[model.ee_frame_id]  # the ghost's hand: the end-effector frame on its joint
+        self.hand_joint, self.hand_point = hand.parentJoint, np.array(hand.placement.translation, dtype=float)
+        self.ghost_name = self.callouts.add("ghost", ghost.label_text, parent=ghost.robot.node_names[self.hand_joint])
         self.rest = scene.robot.rest_base_placement()  # the handle's parent frame (FsmsScene.BASE_AT_REST)
 
     def frame(self, now: float, labels_on: bool) -> None:
-        self.scene.base_callout.point = self.scene.base_label_point()
+        self.scene.attach_base_callout()
         if self.drag is not None and self.handle is not None:
-            self.drag.point = self.rest.act(np.asarray(self.handle.position, dtype=float))
+            self.drag.attach(self.rest.rotation, self.rest.translation, np.asarray(self.handle.position, dtype=float))
             self.drag.shown = bool(self.handle.visible)
         self.ghost_name.shown = bool(self.ghost.root.visible)
         self.ghost_name.text = self.ghost.label_text
-        self.ghost_name.point = self.ghost.robot.ee_position() if self.ghost_name.shown else None
+        if self.ghost_name.shown:
+            hand = self.ghost.robot.data.oMi[self.hand_joint]
+            self.ghost_name.attach(hand.rotation, hand.translation, self.hand_point)
         self.callouts.frame(now, self.pages(), self.solids, labels_on)
 
     def pages(self) -> list[PageCamera]:
