@@ -4,6 +4,7 @@ per-model first look is one table; on a server open to the network nobody operat
 
 from __future__ import annotations
 
+import time
 from typing import get_args
 
 import numpy as np
@@ -18,7 +19,7 @@ from rns_viz.params import MODEL_NAMES, missing_extra
 from rns_viz.viz.panels.glossary import KEYS
 from rns_viz.viz.panels.keys import jog_step
 from rns_viz.viz.scene.framing import frame_points
-from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, FsmsScene
 from rns_viz.viz.scene.view_toggles import TOGGLES, first_look
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.app_helpers import stepped_app
@@ -246,3 +247,30 @@ def test_present_option_reaches_the_app_and_makes_the_projector_screen(monkeypat
             assert g.plots_panel.visible and g.readouts.visible and g.kick.visible  # what a demo needs stays
         finally:
             app.stop()
+
+
+def test_a_page_is_framed_again_for_a_new_size_unless_its_view_was_moved(trep_app: RnsApp) -> None:
+    """A page's camera messages carry its canvas size: a resize re-frames a view nobody moved; a moved view
+    stays where the user put it, until the page turns narrow (a phone's panel sheet covers the lower part)."""
+    scene, wxyz = trep_app.scene, (1.0, 0.0, 0.0, 0.0)
+
+    def framed(size: tuple[int, int]) -> np.ndarray:  # where the app puts a camera of fov 1 rad for this canvas
+        return scene.camera_pose(1.0, size[0] / size[1], size[0]).position
+
+    with ProtocolClient(trep_app.port) as ws:
+        wait_for_clients(trep_app, 1, "the page")
+        client = next(iter(trep_app.server.get_clients().values()))
+        at = lambda size: np.allclose(client.camera.position, framed(size), atol=1e-6)  # noqa: E731
+        ws.camera(wxyz, (5.0, 5.0, 5.0), size=(1280, 720))  # the first report: framed for it
+        wait_until(lambda: at((1280, 720)), 5.0, "the first framing")
+        ws.camera(wxyz, tuple(framed((1280, 720))), size=(1000, 720))  # resized, the view as framed
+        wait_until(lambda: at((1000, 720)), 5.0, "the page framed for its new size")
+        moved = (3.0, -2.0, 1.5)
+        time.sleep(REFRAME_SETTLE_S)  # (a size reported within this of a framing is the page still settling)
+        ws.camera(wxyz, moved, size=(1000, 720))  # the user orbits ...
+        ws.camera(wxyz, moved, size=(900, 720))  # ... then resizes the window: the view is theirs
+        wait_until(lambda: client.camera.image_width == 900, 5.0, "the resize reported")
+        assert np.allclose(client.camera.position, moved)
+        ws.camera(wxyz, moved, size=(390, 844))  # turned narrow: framed in the band above the sheet
+        wait_until(lambda: at((390, 844)), 5.0, "the narrow page framed")
+        assert not np.allclose(framed((390, 844)), framed((900, 720)))

@@ -8,10 +8,12 @@ Screenshots: artifacts/stage_<model>_<w>x<h>.png.
 from __future__ import annotations
 
 import contextlib
+import time
 
 import numpy as np
 import pytest
 
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     PROJECT,
@@ -132,10 +134,11 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
             # Frame robot after the camera flew away: the arm is back in view
             page.set_viewport_size({"width": 1366, "height": 768})
             # the page turned wide again: it is framed for its new layout (app.py); move the camera after that
-            wait_until(lambda: shown_size(page)[0] > 576 and reported_size(client) == shown_size(page), 10.0, "wide")
+            wait_until(lambda: shown_size(page)[0] > 576 and reported_size(client) == shown_size(page), 20.0, "wide")
             cw, ch = reported_size(client)
             wide = app.scene.camera_pose(client.camera.fov, cw / ch, cw).position
             wait_until(lambda: np.allclose(client.camera.position, wide, atol=1e-4), 15.0, "the page framed again")
+            time.sleep(REFRAME_SETTLE_S)  # the page settled: a size it reports now no longer re-frames it
             client.camera.position = client.camera.position + np.array(
                 [0.0, 0.0, 50.0 * float(np.ptp(app.scene.framed))]
             )

@@ -132,8 +132,15 @@ class ProtocolClient:
         with self._lock:
             self._ws.send(payload)
 
-    def camera(self, wxyz: tuple[float, ...], position: tuple[float, float, float]) -> None:
-        """A viewer camera report, as the browser sends when it starts and when the view moves."""
+    def camera(
+        self,
+        wxyz: tuple[float, ...],
+        position: tuple[float, float, float],
+        size: tuple[int, int] = (1280, 720),
+        look_at: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    ) -> None:
+        """A viewer camera report, as the browser sends when it starts, when the view moves and when its
+        canvas changes ``size`` (width, height px)."""
         self._send(
             _messages.ViewerCameraMessage(
                 wxyz=tuple(wxyz),  # type: ignore[arg-type]
@@ -141,9 +148,9 @@ class ProtocolClient:
                 fov=1.0,
                 near=0.01,
                 far=100.0,
-                image_height=720,
-                image_width=1280,
-                look_at=(0.0, 0.0, 0.0),
+                image_height=size[1],
+                image_width=size[0],
+                look_at=look_at,
                 up_direction=(0.0, 0.0, 1.0),
             )
         )

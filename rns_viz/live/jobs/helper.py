@@ -229,7 +229,7 @@ class _Helper:
     def _submit(self, request: bytes) -> Future[bytes]:
         """The future of ``request`` in the helper, which is started first if there is none or it died
         while idle (not this job's doing, so the job gets a new one)."""
-        if self.pool is not None and not all(p.is_alive() for p in self.processes):
+        if self.pool is not None and not all(_running(p) for p in self.processes):
             self.close()
         if self.pool is not None:
             return self.pool.submit(_compute, request)
@@ -262,3 +262,17 @@ threading._register_atexit(_helper.kill)  # type: ignore[attr-defined]
 def call(name: str, *args: Any) -> Any:
     """Run job ``name`` with ``args`` in the helper process and return its result (JobError if it failed)."""
     return _helper.call(name, *args)
+
+
+def _running(process: BaseProcess) -> bool:
+    """Whether the helper process still runs. ``is_alive()`` alone is not enough: when the pool's own thread
+    reaped a dead helper first, this handle can no longer read its exit and still says alive."""
+    if not process.is_alive() or process.pid is None:
+        return False
+    try:
+        os.kill(process.pid, 0)  # signal 0: only asks whether the process exists
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

@@ -9,6 +9,7 @@ which follows the drawn base, so the end effector stays on its drawn path while 
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from typing import Literal
 
@@ -21,7 +22,15 @@ from rns_viz.paths import ReactionlessPath
 from rns_viz.viz.scene.base_drawing import CartSpringDrawing, DoubleBeamDrawing
 from rns_viz.viz.scene.boom_drawing import BoomDrawing
 from rns_viz.viz.scene.callouts import Callout, Callouts
-from rns_viz.viz.scene.framing import DEFAULT_ASPECT, DEFAULT_FOV, CameraPose, band_for, frame_points, framed_points
+from rns_viz.viz.scene.framing import (
+    DEFAULT_ASPECT,
+    DEFAULT_FOV,
+    NARROW_PX,
+    CameraPose,
+    band_for,
+    frame_points,
+    framed_points,
+)
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.scene.shapes import Trail, path_colours, path_family_segments, polyline_segments
@@ -35,6 +44,7 @@ PATH_WIDTH_PX = 4.0
 TRAIL_COLOUR = (0.20, 0.65, 0.30)
 FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
 TARGET_COLOUR = (30, 170, 90)
+REFRAME_SETTLE_S = 2.0  # s after a framing in which a page's new size frames it again (a resize comes in steps)
 REACH_COLOUR = (196, 182, 236)  # pale, under the arm
 
 
@@ -147,6 +157,8 @@ class FsmsScene:
         self.base_label = self.base_callout.label
         self.framed = framed_points(model)  # world points the camera frames
         self.also_framed: np.ndarray | None = None  # more of them while shown (the gain map's corners)
+        # page -> (canvas px, camera position m, time s) when it was last framed
+        self.framed_pages: dict[int, tuple[tuple[int, int], np.ndarray, float]] = {}
         self.set_initial_camera()
         self.q = model.q(model.spec.default_configuration)
         self.exaggeration = 1.0
@@ -280,6 +292,34 @@ class FsmsScene:
             cam.up_direction = (0.0, 0.0, 1.0)
             cam.position = pose.position  # (viser moves look_at with the position: it is set after)
             cam.look_at = pose.look_at
+        self.framed_pages[client.client_id] = (
+            (width, height),
+            np.asarray(pose.position, dtype=float),
+            time.monotonic(),
+        )
+
+    def follow_page_size(self, client: viser.ClientHandle) -> None:
+        """On a page's camera message: frame it if it never was; again if its canvas changed size while its
+        view is still the one framed (nobody moved it) or the page is still settling from the last framing (a
+        resize comes as several sizes, while the view may still glide), or if it turned narrow or wide (a phone's
+        panel sheet then covers or leaves the scene's lower part, where the arm would hide). A view the user
+        moved stays."""
+        cam = client.camera
+        width, height = cam.image_width, cam.image_height
+        if width <= 0 or height <= 0:
+            return
+        last = self.framed_pages.get(client.client_id)
+        if last is None:
+            self.frame_client(client)
+            return
+        (w0, h0), position, when = last
+        if (w0, h0) == (width, height):
+            return
+        turned = (0 < w0 < NARROW_PX) != (width < NARROW_PX)
+        distance = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
+        untouched = bool(np.allclose(cam.position, position, atol=1e-4 * max(distance, 1e-3)))
+        if turned or untouched or time.monotonic() - when < REFRAME_SETTLE_S:
+            self.frame_client(client)
 
     # -- internals -----------------------------------------------------------------------------
     def _trail_point(self) -> np.ndarray:

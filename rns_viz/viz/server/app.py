@@ -37,7 +37,6 @@ from rns_viz.viz.panels.path_words import PathWords
 from rns_viz.viz.panels.pictures import Pictures
 from rns_viz.viz.panels.rank_inset import RankInsetPanel
 from rns_viz.viz.panels.replay_panel import ReplayPanel
-from rns_viz.viz.scene.framing import NARROW_PX
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.view_toggles import first_look, make_view_toggles
 from rns_viz.viz.server.page_pacing import ClientPace
@@ -183,18 +182,8 @@ class RnsApp:
         back after a moment) keeps the simulation, its recording and, for the operator's page, control."""
         self.connections.client_joined(client)
         self.pace.client_joined(client)
-        framed_narrow: list[bool] = []  # whether the page was narrow when last framed (empty: not yet framed)
-
-        @client.camera.on_update
-        def _(_: viser.CameraHandle) -> None:
-            # The page's first camera message tells its size: frame for it. Framed again when the page turns
-            # narrow or wide (a phone rotated, a window narrowed): the panel then moves over or off the scene's
-            # lower part, where the arm would hide behind the sheet. Other moves of the view stay the user's.
-            width = client.camera.image_width
-            narrow = 0 < width < NARROW_PX
-            if width > 0 and framed_narrow[-1:] != [narrow]:
-                framed_narrow[:] = [narrow]
-                self.scene.frame_client(client)
+        # the page's camera messages tell its size: framed for it first, and again as scene.follow_page_size says
+        client.camera.on_update(lambda _: self.scene.follow_page_size(client))
 
         with self._visitors:
             since, self._unwatched_since = self._unwatched_since, None
