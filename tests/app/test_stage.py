@@ -261,16 +261,18 @@ def test_a_page_is_framed_again_for_a_new_size_unless_its_view_was_moved(trep_ap
         wait_for_clients(trep_app, 1, "the page")
         client = next(iter(trep_app.server.get_clients().values()))
         at = lambda size: np.allclose(client.camera.position, framed(size), atol=1e-6)  # noqa: E731
-        ws.camera(wxyz, (5.0, 5.0, 5.0), size=(1280, 720))  # the first report: framed for it
-        wait_until(lambda: at((1280, 720)), 5.0, "the first framing")
-        ws.camera(wxyz, tuple(framed((1280, 720))), size=(1000, 720))  # resized, the view as framed
-        wait_until(lambda: at((1000, 720)), 5.0, "the page framed for its new size")
+        # the page's first report (or, if the app saw the one sent on connecting, a resize just after it)
+        ws.camera(wxyz, (5.0, 5.0, 5.0), size=(1200, 700))
+        wait_until(lambda: at((1200, 700)), 10.0, "the first framing")
+        time.sleep(REFRAME_SETTLE_S)  # the page settled
+        ws.camera(wxyz, tuple(framed((1200, 700))), size=(1000, 720))  # resized, the view as framed
+        wait_until(lambda: at((1000, 720)), 10.0, "the page framed for its new size")
         moved = (3.0, -2.0, 1.5)
         time.sleep(REFRAME_SETTLE_S)  # (a size reported within this of a framing is the page still settling)
         ws.camera(wxyz, moved, size=(1000, 720))  # the user orbits ...
         ws.camera(wxyz, moved, size=(900, 720))  # ... then resizes the window: the view is theirs
-        wait_until(lambda: client.camera.image_width == 900, 5.0, "the resize reported")
+        wait_until(lambda: client.camera.image_width == 900, 10.0, "the resize reported")
         assert np.allclose(client.camera.position, moved)
         ws.camera(wxyz, moved, size=(390, 844))  # turned narrow: framed in the band above the sheet
-        wait_until(lambda: at((390, 844)), 5.0, "the narrow page framed")
+        wait_until(lambda: at((390, 844)), 10.0, "the narrow page framed")
         assert not np.allclose(framed((390, 844)), framed((900, 720)))

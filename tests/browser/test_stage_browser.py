@@ -13,7 +13,7 @@ import time
 import numpy as np
 import pytest
 
-from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, RESIZE_PX
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     PROJECT,
@@ -133,11 +133,26 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                 screenshot(page, f"stage_{model}_{w}x{h}")
             # Frame robot after the camera flew away: the arm is back in view
             page.set_viewport_size({"width": 1366, "height": 768})
-            # the page turned wide again: it is framed for its new layout (app.py); move the camera after that
-            wait_until(lambda: shown_size(page)[0] > 576 and reported_size(client) == shown_size(page), 20.0, "wide")
-            cw, ch = reported_size(client)
-            wide = app.scene.camera_pose(client.camera.fov, cw / ch, cw).position
-            wait_until(lambda: np.allclose(client.camera.position, wide, atol=1e-4), 15.0, "the page framed again")
+            # the page turned wide again: framed for its new layout (FsmsScene.follow_page_size); then move the camera
+
+            def laid_out() -> bool:  # the canvas has its new size, held for half a second, and the server has it
+                before = shown_size(page)
+                time.sleep(0.5)
+                now = shown_size(page)
+                return now == before and now[0] != 390 and reported_size(client) == now
+
+            try:
+                wait_until(laid_out, 20.0, "the page laid out at 1366x768")
+            except AssertionError as e:
+                raise AssertionError(f"{e}: canvas {shown_size(page)}, reported {reported_size(client)}") from e
+
+            def framed_for_now() -> bool:  # the app's last framing of this page is for (about) its size now
+                (fw, fh), position, _ = app.scene.framed_pages[client.client_id]
+                cw, ch = reported_size(client)
+                near = abs(fw - cw) <= RESIZE_PX and abs(fh - ch) <= RESIZE_PX
+                return near and fw > 576 and np.allclose(client.camera.position, position, atol=1e-4)
+
+            wait_until(framed_for_now, 15.0, "the page framed again")
             time.sleep(REFRAME_SETTLE_S)  # the page settled: a size it reports now no longer re-frames it
             client.camera.position = client.camera.position + np.array(
                 [0.0, 0.0, 50.0 * float(np.ptp(app.scene.framed))]

@@ -44,6 +44,7 @@ PATH_WIDTH_PX = 4.0
 TRAIL_COLOUR = (0.20, 0.65, 0.30)
 FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
 TARGET_COLOUR = (30, 170, 90)
+RESIZE_PX = 8  # a canvas that changed by at most this (px) each way keeps its framing
 REFRAME_SETTLE_S = 2.0  # s after a framing in which a page's new size frames it again (a resize comes in steps)
 REACH_COLOUR = (196, 182, 236)  # pale, under the arm
 
@@ -313,7 +314,7 @@ class FsmsScene:
             self.frame_client(client)
             return
         (w0, h0), position, when = last
-        if (w0, h0) == (width, height):
+        if abs(width - w0) <= RESIZE_PX and abs(height - h0) <= RESIZE_PX:  # the same page, to rounding
             return
         turned = (0 < w0 < NARROW_PX) != (width < NARROW_PX)
         distance = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
