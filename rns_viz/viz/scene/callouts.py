@@ -154,7 +154,7 @@ class Callouts:
             if not (np.all(np.isfinite(point_px)) and depth > 0):
                 continue
             size = text_size(item.text)
-            where = self._scored_elsewhere(point, point_px, float(depth), size, pages, occupied)
+            where = self._scored_elsewhere(point_px, float(depth), size, pages, occupied)
             away = point_px - np.nanmean(primary.project(solids.reshape(-1, 3))[0], axis=0) if len(solids) else None
             tried = [item.placement] if item.placement is not None else []
             best, best_cost = item.placement, np.inf
@@ -176,7 +176,6 @@ class Callouts:
 
     @staticmethod
     def _scored_elsewhere(
-        point: np.ndarray,
         point_px: np.ndarray,
         depth: float,
         size: tuple[float, float],
