@@ -13,6 +13,8 @@ Run on demand (the machine should be quiet: the load average is printed with eve
    The ramp stops at the first count where a simulation falls below RTF 0.99 in two windows running; the
    answer is the count before.
    ``--profile`` samples the server with py-spy at the largest count that kept real time (where the time goes).
+   ``--step python`` runs the servers with the pure-Python step even when the optional native step
+   (``pip install ./native``) is installed; ``--step native`` requires it. The step used is printed.
 2. ``student``: one ``rns-viz serve`` as jupyter-server-proxy starts it for a student (one simulation), its
    CPU and memory with nobody watching (idle) and with one page watching and kicking (active); and, if
    jupyter-server-proxy is installed, a Jupyter server's own memory with the extension loaded. These are
@@ -52,14 +54,27 @@ def rss_mb(pid: int | str = "self") -> float:
 
 
 # ---------------------------------------------------------------- server side (child processes)
-def serve_visitors() -> None:
+def choose_step(step: str) -> bool:
+    """Before rns_viz is imported: keep the native step out ("python"), or require it ("native"); whether the
+    native step runs."""
+    if step == "python":
+        sys.modules["rns_viz_native"] = None  # type: ignore[assignment]  # an import of it now fails as not installed
+    from rns_viz.sim import native
+
+    if step == "native" and not native.available():
+        raise SystemExit(f"--step native: {native.unavailable_reason()}")
+    return native.available()
+
+
+def serve_visitors(step: str) -> None:
     """The per-visitor server; answers 'stats' with every simulation's clock, CPU and memory."""
+    native = choose_step(step)
     from rns_viz.viz.server.classroom import start_classroom
 
     out, sys.stdout = sys.stdout, sys.stderr
     room = start_classroom("trep", port=0, max_visitors=1000, verbose=False)
     threading.Thread(target=kick_forever, args=(lambda: list(room.apps().values()),), daemon=True).start()
-    print(json.dumps({"port": room.port, "pid": os.getpid()}), file=out, flush=True)
+    print(json.dumps({"port": room.port, "pid": os.getpid(), "native": native}), file=out, flush=True)
     for line in sys.stdin:
         if line.strip() == "quit":
             break
@@ -70,16 +85,17 @@ def serve_visitors() -> None:
     room.stop()
 
 
-def serve_student() -> None:
+def serve_student(step: str) -> None:
     """One student's app, as the proxy starts it (paused while no page is open); answers 'stats' like
     :func:`serve_visitors`."""
+    native = choose_step(step)
     from rns_viz.viz.server.app import start_app
 
     out, sys.stdout = sys.stdout, sys.stderr
     app = start_app("trep", port=0, verbose=False, pause_unwatched=True)
     watched = threading.Event()
     threading.Thread(target=kick_forever, args=(lambda: [app] if watched.is_set() else [],), daemon=True).start()
-    print(json.dumps({"port": app.port, "pid": os.getpid()}), file=out, flush=True)
+    print(json.dumps({"port": app.port, "pid": os.getpid(), "native": native}), file=out, flush=True)
     for line in sys.stdin:
         if line.strip() == "quit":
             break
@@ -108,12 +124,15 @@ def kick_forever(apps: Any) -> None:
 
 # ---------------------------------------------------------------- client side
 class Child:
+    step = "installed"  # --step, for every child
+
     def __init__(self, role: str) -> None:
-        command = [sys.executable, __file__, "--serve", role]
+        command = [sys.executable, __file__, "--serve", role, "--step", Child.step]
         self.proc = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, cwd=ROOT)
         assert self.proc.stdout is not None
         info = json.loads(self.proc.stdout.readline())
         self.port, self.pid = int(info["port"]), int(info["pid"])
+        print(f"  (the server runs the {'native' if info['native'] else 'pure-Python'} step)", flush=True)
 
     def ask(self, line: str = "stats") -> dict[str, Any]:
         assert self.proc.stdin is not None and self.proc.stdout is not None
@@ -282,12 +301,19 @@ def main() -> None:
     parser.add_argument("--window", type=float, default=15.0, help="s measured per step (default 15)")
     parser.add_argument("--max", type=int, default=12, help="most visitors tried (default 12)")
     parser.add_argument("--profile", action="store_true", help="sample the server with py-spy")
+    parser.add_argument(
+        "--step",
+        choices=("installed", "python", "native"),
+        default="installed",
+        help="the simulation step: the native one if installed (default), pure Python, or native (required)",
+    )
     args = parser.parse_args()
+    Child.step = args.step
     if args.serve == "visitors":
-        serve_visitors()
+        serve_visitors(args.step)
         return
     if args.serve == "student":
-        serve_student()
+        serve_student(args.step)
         return
     print(f"# {os.cpu_count()} cores; load average at start {load()}")
     if args.only in (None, "visitors"):

@@ -214,7 +214,7 @@ def test_every_preset_and_lesson_says_what_to_look_at() -> None:
     """Each preset's panel text and each lesson's text carries a 'Look at:' line of its own."""
     from rns_viz.live.teaching.lessons import LESSON_LIBRARY
     from rns_viz.scenarios import LIVE_SCENARIOS
-    from rns_viz.viz.panels.control_panel import preset_description
+    from rns_viz.viz.panels.preset_rows import preset_description
 
     for name, preset in LIVE_SCENARIOS.items():
         assert len(preset.look) > 20, name

@@ -18,6 +18,7 @@ from playwright.sync_api import Page
 from rns_viz.analysis import GainMap
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.viz.panels.gain_panel import QUANTITIES
+from rns_viz.viz.scene.framing import main_panel_box
 from rns_viz.viz.scene.gain_scene import (
     MISSING_RGB,
     UNSTABLE_HATCH,
@@ -183,8 +184,9 @@ FACING_FILL = 0.9  # the faced map spans this fraction of the scene's narrower s
 
 
 def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
-    """Put the page's camera in front of the map, looking at its centre, at the distance where the map spans
-    FACING_FILL of the scene's width or height, whichever is narrower (the page's own field of view)."""
+    """Put the page's camera in front of the map, at the distance where the map spans FACING_FILL of the
+    scene's width or height below the floating main panel, whichever is narrower (the page's own field of
+    view), its centre in the middle of that part of the scene."""
     client = next(iter(app.server.get_clients().values()))
     cam = client.camera
     wait_until(lambda: cam.update_timestamp > 0 and cam.image_width > 0, 10.0, "the page's camera")
@@ -194,9 +196,18 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
         " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
         " return [c.clientWidth, c.clientHeight]; }"
     )
-    half_view = math.tan(0.5 * cam.fov) * min(width / height, 1.0)  # per unit of distance
-    cam.position = scene.centre + 0.5 * scene.size / (FACING_FILL * half_view) * scene.rotation[:, 2]
-    cam.look_at = scene.centre
+    panel = main_panel_box(width)
+    below = panel[3] if panel is not None else 0.0  # px: the rows above are partly under the main panel
+    free = height - below
+    focal = 0.5 * height / math.tan(0.5 * cam.fov)  # px per unit of (offset / distance)
+    distance = 0.5 * scene.size * focal / (FACING_FILL * 0.5 * min(width, free))
+    ahead = -scene.rotation[:, 2]  # the camera looks along this, at the map
+    up = np.asarray(cam.up_direction, dtype=float)
+    up = up - (up @ ahead) * ahead
+    up /= np.linalg.norm(up)
+    shift = -0.5 * below / focal * distance * up  # the map's centre half the panel's rows down the page
+    cam.position = scene.centre + distance * scene.rotation[:, 2] - shift
+    cam.look_at = scene.centre - shift
     wait_for_frames(page, 10)
 
 

@@ -1,7 +1,8 @@
 """The stage in a real Chromium, one page per bundled model resized to a projector, a laptop and a phone:
 the arm (its joints and its end-effector frame), projected by the page's own camera, lies inside the
 view and spans a stated fraction of it; at the two larger sizes the base-deflection plot is inside the
-viewport without scrolling; Frame robot brings the arm back after the camera was moved away.
+viewport without scrolling, on the phone the controls start closed and the plot shows; Frame robot
+brings the arm back after the camera was moved away.
 Screenshots: artifacts/stage_<model>_<w>x<h>.png.
 """
 
@@ -13,6 +14,7 @@ import time
 import numpy as np
 import pytest
 
+from rns_viz.viz.scene.framing import NARROW_PX
 from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, RESIZE_PX
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
@@ -35,6 +37,8 @@ MIN_SPAN = 0.2
 # ... except boom7 on a phone: its framing box (the arm's axis-aligned box, seen obliquely, fitted into the band
 # above the panel's sheet) leaves the tall arm 0.12 of the view; the aim is MIN_SPAN, this is what it keeps
 PHONE_MIN_SPAN = {"boom7": 0.1}
+# ... and the base-deflection chart's plot at least this much inside a phone's page, the controls closed
+PHONE_CHART_SHOWN = 0.5
 # a point given in a scene node's frame (m) to page pixels by the page's own camera (PROJECT: the node's origin)
 PROJECT_IN_NODE = """([name, x, y, z]) => {
   const m = window.__viserMutable, obj = m.nodeRefFromName[name], cam = m.camera;
@@ -46,6 +50,35 @@ PROJECT_IN_NODE = """([name, x, y, z]) => {
   const rect = m.canvas.getBoundingClientRect();
   return [rect.left + ((c[0] / c[3] + 1) / 2) * rect.width, rect.top + ((1 - c[1] / c[3]) / 2) * rect.height];
 }"""
+
+
+def reachable(page, text: str) -> bool:  # type: ignore[no-untyped-def]
+    """Whether a tap at the centre of a button reading ``text`` lands on it (a closed section's buttons are
+    either not in the page or laid out and clipped away)."""
+    return bool(
+        page.evaluate(
+            """(text) => [...document.querySelectorAll('button')].filter((b) => b.innerText.includes(text))
+            .some((b) => { const r = b.getBoundingClientRect();
+              if (r.width === 0 || r.height === 0) return false;
+              const e = document.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
+              return e !== null && b.contains(e); })""",
+            text,
+        )
+    )
+
+
+def chart_shown(page) -> float:  # type: ignore[no-untyped-def]
+    """The fraction of the base-deflection chart (the uPlot titled so) inside the viewport."""
+    return float(
+        page.evaluate(
+            """() => { const c = [...document.querySelectorAll('.uplot')].find((u) =>
+              (u.querySelector('.u-title')?.innerText ?? '').includes('Base vibration')); if (!c) return 0;
+            const r = c.getBoundingClientRect(), h = window.innerHeight, w = window.innerWidth;
+            const dy = Math.max(0, Math.min(r.bottom, h) - Math.max(r.top, 0));
+            const dx = Math.max(0, Math.min(r.right, w) - Math.max(r.left, 0));
+            return r.height > 0 && r.width > 0 ? (dy * dx) / (r.height * r.width) : 0; }"""
+        )
+    )
 
 
 def arm_pixels(page, names: list[str], app: RnsApp) -> np.ndarray:
@@ -122,13 +155,18 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                     wait_until(lambda: at_rest(page, joints, app), 15.0, f"the view at rest at {w}x{h}")
                 inside, span = arm_on_screen(page, joints, app)
                 print(f"\n{model} {w}x{h}: arm spans {span:.3f} of the view", end="")
-                least = PHONE_MIN_SPAN.get(model, MIN_SPAN) if w < 576 else MIN_SPAN
+                least = PHONE_MIN_SPAN.get(model, MIN_SPAN) if w < NARROW_PX else MIN_SPAN
                 assert inside and span >= least, (w, h, span)
                 if w >= 1366:  # the base-deflection chart: in the viewport, no scrolling
                     chart = page.get_by_text("Base vibration x_b").first
                     box = chart.bounding_box()
                     assert box is not None and box["y"] >= 0 and box["y"] + box["height"] <= h, box
                     assert box["x"] >= 0 and box["x"] + box["width"] <= w
+                else:  # a phone: the controls start closed, the base-deflection chart shows in the sheet
+                    wait_until(lambda: not reachable(page, "Next"), 10.0, "the controls closed on a phone")
+                    shown = chart_shown(page)
+                    print(f", x_b chart {shown:.2f} shown", end="")
+                    assert shown >= PHONE_CHART_SHOWN, shown
                 settle_for_picture(page, 20)
                 screenshot(page, f"stage_{model}_{w}x{h}")
             # Frame robot after the camera flew away: the arm is back in view
@@ -150,7 +188,7 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                 (fw, fh), position, _ = app.scene.framed_pages[client.client_id]
                 cw, ch = reported_size(client)
                 near = abs(fw - cw) <= RESIZE_PX and abs(fh - ch) <= RESIZE_PX
-                return near and fw > 576 and np.allclose(client.camera.position, position, atol=1e-4)
+                return near and fw > NARROW_PX and np.allclose(client.camera.position, position, atol=1e-4)
 
             wait_until(framed_for_now, 15.0, "the page framed again")
             time.sleep(REFRAME_SETTLE_S)  # the page settled: a size it reports now no longer re-frames it

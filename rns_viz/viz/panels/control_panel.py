@@ -1,15 +1,17 @@
-"""The app's control panel: every GUI element, built once by :func:`make_gui`.
+"""The app's panels: every GUI element, built once by :func:`make_gui`.
 
-Layout, top to bottom (kick, presets and plots fit one 900 px screen): a status line; *Operate*
-(kick, suppression, run controls); *Paper presets*; *Live plots*; *Readouts*; *Reactionless path*
-(a 1-D reaction null space) or *Target* (otherwise); *Control law and gains*; *Model and view*; *Log*.
-Labels carry units; hints explain the symbols. Model-specific elements are shown or hidden by the app,
-and their words set per model (rns_viz.viz.panels.model_words).
+Three places (see the comment in :func:`make_gui`): the status line and *Live plots* docked left;
+*Controls* docked right (lessons, *Operate*, *Paper presets*, *Readouts*, *Reactionless path* or
+*Target*, *Control law and gains*, *Model and view*, the rest), with a *Help* tab; viser's main panel,
+small and floating, with *Frame robot* (and each page's operator seat). Labels carry units; hints
+explain the symbols. Model-specific elements are shown or hidden by the app, and their words set per
+model (rns_viz.viz.panels.model_words).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import viser
 import viser.uplot
@@ -18,13 +20,16 @@ from rns_viz.defaults import defaults_for
 from rns_viz.live.loop.commands import LIVE_LAWS as LAW_KINDS
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.runs.laws import LAW_LABELS
-from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, LIVE_SCENARIOS, presets_for
+from rns_viz.scenarios import FIG11_FAST_S, FIG11_SLOW_S, presets_for
 from rns_viz.viz.panels.glossary import glossary_markdown
 from rns_viz.viz.panels.live_plots import LivePlots
 from rns_viz.viz.panels.model_menu import ModelMenu
 from rns_viz.viz.panels.number_field import NumberField, hide_slider_boxes
+from rns_viz.viz.panels.preset_rows import preset_hint, show_presets
+from rns_viz.viz.scene.framing import MAIN_PANEL_PX
 
 PLOTS_WIDTH_PX = 360  # the docked plots' width: a 1366 px screen keeps ~600 px of scene between the panels
+CONTROLS_WIDTH_PX = 384  # the docked controls' width (viser's "large" control panel)
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
@@ -97,6 +102,8 @@ class GuiElements:
     readouts: viser.GuiHtmlHandle
     plots: LivePlots
     plots_panel: viser.PanelHandle
+    controls_panel: viser.PanelHandle
+    controls_tab: viser.GuiTabHandle  # the app adds its other folders inside it (``with gui.controls_tab:``)
     path_folder: viser.GuiFolderHandle
     sigma: NumberField
     play_slow: viser.GuiButtonHandle
@@ -139,26 +146,52 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     """Build the panel for ``model`` (its kick range and exaggeration; ``menu``: the models offered, by
     default the bundled ones); the app wires the callbacks."""
     menu = menu or ModelMenu((model,))
-    defaults = defaults_for(model)
     gui = server.gui
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
-    gui.main_panel.dock_right()
+    # Three places. The status line and the live plots dock left, in view beside the robot whatever the
+    # controls are scrolled to; the controls dock right in a panel of their own; viser's main panel keeps only
+    # Frame robot and who operates (a page's own), floating small in the scene's top right corner (callouts
+    # keep off it). On a phone viser shows the main panel as a sheet over the page, opened: it is short this
+    # way, and the two panels are sections under it (the plots opened, so a watcher sees the base plot; the
+    # controls closed until tapped).
+    x, y, width = MAIN_PANEL_PX
+    gui.main_panel.float(x=x, y=y, width=width)
     hide_slider_boxes(gui)  # every slider's value is shown and typed in its NumberField's box
-    # The live plots in their own panel, docked left of the scene: in view beside the robot whatever the
-    # main panel is scrolled to (on a phone: a section of viser's bottom sheet, collapsed at first).
+    controls_panel = gui.add_panel(order=-1.0)  # first of the phone's sections: a short bar when closed
+    controls_tab = controls_panel.add_tab("Controls", viser.Icon.ADJUSTMENTS)
+    with controls_panel.add_tab("Help: words and keys", viser.Icon.HELP):
+        gui.add_markdown(glossary_markdown())
+    controls_panel.dock_right()
+    controls_panel.set_width(CONTROLS_WIDTH_PX)
     plots_panel = gui.add_panel(order=0.0)
     with plots_panel.add_tab("Live plots (last 10 s)", viser.Icon.CHART_LINE):
+        status = gui.add_html("")
         plots = LivePlots(gui)
-    with plots_panel.add_tab("Help: words and keys", viser.Icon.HELP):
-        gui.add_markdown(glossary_markdown())
     plots_panel.dock_left()
     plots_panel.set_width(PLOTS_WIDTH_PX)
-    status = gui.add_html("")
+    plots_panel.expand()  # on a phone too (panels there start closed)
     frame_robot = gui.add_button(
         "Frame robot",
         icon=viser.Icon.FOCUS_CENTERED,
         hint="Your camera back on the robot, framed for your screen (key F). Moves only your own view.",
     )
+    with controls_tab:
+        elements = _controls(gui, model, menu)
+    return GuiElements(
+        status=status,
+        frame_robot=frame_robot,
+        plots=plots,
+        plots_panel=plots_panel,
+        controls_panel=controls_panel,
+        controls_tab=controls_tab,
+        menu=menu,
+        **elements,
+    )
+
+
+def _controls(gui: viser.GuiApi, model: str, menu: ModelMenu) -> dict[str, Any]:
+    """The controls panel's own elements, by the names of :class:`GuiElements`."""
+    defaults = defaults_for(model)
     gui.add_markdown(
         "**Try:** a *Paper preset*, then *Resume*; *Kick the base* with suppression on and off; "
         "drag the handle labelled **drag me** in the scene (its arrows or its square)."
@@ -324,9 +357,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         icon=viser.Icon.DOWNLOAD,
         hint="The last 20 s of the simulation, one row per 1 ms step, SI units (the documentation lists the columns).",
     )
-    return GuiElements(
-        status=status,
-        frame_robot=frame_robot,
+    return dict(
         kick=kick,
         kick_peak=kick_peak,
         suppression=suppression,
@@ -335,8 +366,6 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         reset=reset,
         speed=speed,
         readouts=readouts,
-        plots=plots,
-        plots_panel=plots_panel,
         path_folder=path_folder,
         sigma=sigma,
         play_slow=play_slow,
@@ -354,38 +383,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         preset_paused=preset_paused,
         preset_info=preset_info,
         model=model_dd,
-        menu=menu,
         exaggeration=exaggeration,
         auto_exaggeration=auto_exaggeration,
         shadow=shadow,
         download=download,
     )
-
-
-def preset_hint(names: tuple[str, ...]) -> str:
-    """One click loads a figure's experiment; what each button is, in the paper's figure order."""
-    what = "; ".join(f"{name}: {LIVE_SCENARIOS[name].description.split(': ', 1)[-1]}" for name in names)
-    units = "Gains in 1/s, u-bar in 1/(kg m s)."
-    return f"One click loads a figure's experiment (law, gains, motion, kicks, model). {what}. {units}"
-
-
-def show_presets(presets: dict[str, viser.GuiButtonGroupHandle], menu: ModelMenu, model_key: str) -> None:
-    """One row of presets per heading: models sharing a heading (boom7 and boom-panda: the same boom) share
-    its row, which shows the served model's presets, else those of the first such model in the menu."""
-    served = menu.source_key(model_key)
-    shown: dict[str, str] = {}  # heading -> the key whose presets it shows
-    for key in presets:
-        heading = menu.presets_heading(key)
-        if heading not in shown or key == served:
-            shown[heading] = key
-    for key, group in presets.items():
-        visible = shown[menu.presets_heading(key)] == key
-        if group.visible != visible:
-            group.visible = visible
-
-
-def preset_description(name: str | None) -> str:
-    if name is None:
-        return ""
-    preset = LIVE_SCENARIOS[name]
-    return f"**{name}**: {preset.description}.\n\n**Look at:** {preset.look} Reset restarts it."

@@ -44,6 +44,7 @@ class PageCamera:
     width: int  # px, the canvas
     height: int
     shown: tuple[float, float] | None = None  # px: the rows not under a panel (a phone's sheet); None: all
+    covered: tuple[float, float, float, float] | None = None  # px: a box a floating panel covers (x0, y0, x1, y1)
 
     @property
     def focal(self) -> float:

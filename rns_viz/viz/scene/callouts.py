@@ -29,7 +29,7 @@ from rns_viz.viz.scene.callout_layout import (
     cost,
     text_size,
 )
-from rns_viz.viz.scene.framing import band_for
+from rns_viz.viz.scene.framing import band_for, main_panel_box
 
 LAYOUT_S = 0.25  # s between layouts (while the view or the arm moves; none while both stand still)
 STILL_PX = 1.0  # a layout is skipped while no page's projected point or solid moved more than this
@@ -45,7 +45,7 @@ def page_camera(client: viser.ClientHandle) -> PageCamera | None:
     position, width, height = np.asarray(cam.position, dtype=float), cam.image_width, cam.image_height
     bottom, top = band_for(width)  # NDC y: a phone's panel sheet covers the page below the band
     shown = ((1.0 - top) / 2.0 * height, (1.0 - bottom) / 2.0 * height)
-    return PageCamera(position, rotation, float(cam.fov), width, height, shown)
+    return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width))
 
 
 @dataclass
@@ -141,6 +141,8 @@ class Callouts:
         occupied = []
         for page in pages:
             grid = Occupancy(page.width, page.height, page.shown)
+            if page.covered is not None:
+                grid.add_box(np.array(page.covered))
             for corners in page.project(solids)[0] if len(solids) else ():
                 grid.add_solid(corners)
             for item in live:

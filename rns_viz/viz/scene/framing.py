@@ -20,8 +20,17 @@ from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 
 FILL = 0.72  # the framed box spans at most this fraction of the view's width or height
-NARROW_PX = 576  # px: below this page width viser shows its panel as a sheet over the page's lower part
+# px: a scene this narrow is a phone's page, which viser (below 576 px of page) covers with its panels' sheet
+# from below. The server learns the scene's width only, and on a desktop page the docked panels take
+# 744 px of it: this bound counts a 1280 px desktop page (536 px of scene) as wide, a phone held upright
+# (at most ~430 px) as narrow.
+NARROW_PX = 500
 NARROW_BAND = (0.2, 0.95)  # NDC y band (bottom, top) the robot is fitted into on a narrow page (sheet below)
+# px: viser's main panel floats in the scene's top right corner on a wide page, (x, y, width) as
+# ``main_panel.float`` takes them (negative x: from the right edge), and about this tall (Frame robot and
+# who operates); callouts keep off it
+MAIN_PANEL_PX = (-12, 12, 300)
+MAIN_PANEL_HEIGHT_PX = 190
 PAD_REACH = 0.2  # the box grows by this fraction of the arm's reach on every side: links have thickness
 CLAMP_REACHES = 1.5  # the clamp at the origin is framed if it is within this many arm reaches of the base
 DEFAULT_FOV = 1.309  # rad, viser's vertical field of view
@@ -88,3 +97,13 @@ def frame_points(
 def band_for(width_px: int) -> tuple[float, float]:
     """The vertical band of the view the robot is fitted into on a page ``width_px`` wide."""
     return NARROW_BAND if 0 < width_px < NARROW_PX else (-1.0, 1.0)
+
+
+def main_panel_box(width: int) -> tuple[float, float, float, float] | None:
+    """The floating main panel's box (x0, y0, x1, y1) on a page ``width`` px wide, in the canvas's px;
+    None on a narrow page (a sheet there, below the band of :func:`band_for`)."""
+    if width < NARROW_PX:
+        return None
+    x, y, panel_width = MAIN_PANEL_PX
+    right = width + x if x < 0 else x + panel_width
+    return (right - panel_width, float(y), float(right), float(y + MAIN_PANEL_HEIGHT_PX))

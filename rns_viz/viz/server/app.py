@@ -78,19 +78,20 @@ class RnsApp:
         model = session.snapshot().settings.model
         self.gui: GuiElements = make_gui(server, model, ModelMenu((model, *models)))
         self.controls = Controls(self.gui, session, self.connections)
-        self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
-        self.view = make_view_toggles(server.gui, self.connections, first_look(session.state.model))
-        self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
-        self.lessons = LessonPanel(
-            server, session, self.connections, self.gui.status.order + 0.5, self.view, self.gui.menu.keys.values()
-        )
-        self.renderer = Renderer(
-            server, session, self.gui, self.controls, self.connections, self.view, base_panel=self.base_panel
-        )
-        self.path_words = PathWords(server, self.gui.path_folder, order=self.gui.sigma.order + 0.01)
-        self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
-        self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
-        self.replay = ReplayPanel(server, session, self.controls, self.connections, self.view)
+        with self.gui.controls_tab:  # the folders below go into the docked controls
+            self.base_panel = BasePanel(server, self.controls, order=self.gui.readouts.order + 0.5)
+            self.view = make_view_toggles(server.gui, self.connections, first_look(session.state.model))
+            self.rank_inset = RankInsetPanel(server, self.view)  # shown below the toggles while rank loss is ticked
+            self.lessons = LessonPanel(
+                server, session, self.connections, self.gui.status.order + 0.5, self.view, self.gui.menu.keys.values()
+            )
+            self.renderer = Renderer(
+                server, session, self.gui, self.controls, self.connections, self.view, base_panel=self.base_panel
+            )
+            self.path_words = PathWords(server, self.gui.path_folder, order=self.gui.sigma.order + 0.01)
+            self.renderer.text_panels += [self.lessons.refresh, self.path_words.refresh]
+            self.pictures = Pictures(server, self.connections, lambda: session.snapshot().settings.model)
+            self.replay = ReplayPanel(server, session, self.controls, self.connections, self.view)
         self.renderer.text_panels += [self.replay.refresh, self.rank_inset.refresh]
         # each page gets updates at the rate it can draw; told so under the status line when slowed
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)

@@ -25,12 +25,13 @@ from rns_viz.live.teaching.rank_view import has_rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
-from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements, preset_description, show_presets
+from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements
 from rns_viz.viz.panels.gain_panel import GainExplorerView
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
 from rns_viz.viz.panels.model_words import kick_hint, target_text
 from rns_viz.viz.panels.panel_text import readouts_html, status_html
+from rns_viz.viz.panels.preset_rows import preset_description, show_presets
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_callouts import SceneCallouts
