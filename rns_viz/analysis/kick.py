@@ -138,12 +138,21 @@ def pulse_modes(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: flo
         return g.sum(axis=-1), -g
 
 
-def pulse_states(lam: np.ndarray, mu: np.ndarray | None, dt: float, duration: float, steps: np.ndarray) -> np.ndarray:
-    """xi_i after ``steps`` (J,) control steps into a unit half-sine push, (..., s, J) (:func:`pulse_modes`)."""
+def pulse_states(
+    lam: np.ndarray,
+    mu: np.ndarray | None,
+    dt: float,
+    duration: float,
+    steps: np.ndarray,
+    modes: tuple[np.ndarray, np.ndarray] | None = None,
+) -> np.ndarray:
+    """xi_i after ``steps`` (J,) control steps into a unit half-sine push, (..., s, J), from :func:`pulse_modes`
+    (``modes``: its (c, b) if already at hand)."""
     t = np.asarray(steps, dtype=float) * dt
-    c, b = pulse_modes(lam, mu, dt, duration)
+    c, b = pulse_modes(lam, mu, dt, duration) if modes is None else modes
+    swing = np.exp(1j * (math.pi / duration) * t)  # e^(+i w t); e^(-i w t) is its conjugate
     with np.errstate(over="ignore", invalid="ignore"):  # a growing loop's modes may overflow: it is unstable anyway
-        return _powers(lam, t) * c[..., None] + b @ np.exp(np.array([[1j], [-1j]]) * (math.pi / duration) * t)
+        return _powers(lam, t) * c[..., None] + b[..., :1] * swing + b[..., 1:] * swing.conj()
 
 
 def _powers(lam: np.ndarray, times: np.ndarray) -> np.ndarray:

@@ -40,31 +40,45 @@ def values(lam: np.ndarray, a: np.ndarray, t: np.ndarray) -> np.ndarray:
     return (a * np.exp(lam * t[:, None])).sum(axis=1).real
 
 
-def _falling_root(slope_of, lo: np.ndarray, hi: np.ndarray, t: np.ndarray, steps: int) -> np.ndarray:
-    """A root of g in [lo, hi] (K,), g > 0 before it and < 0 after it, reached from t: Newton steps, bisecting
-    the bracket where a step would leave it or g does not fall. ``slope_of(t)`` gives g and g' at t."""
+def _falling_root(
+    coef: np.ndarray, lam: np.ndarray, shift: np.ndarray, lo: np.ndarray, hi: np.ndarray, t: np.ndarray, steps: int
+) -> np.ndarray:
+    """A root of g(t) = Re sum coef e^(lam t) - shift in [lo, hi] (K,), g > 0 before it and < 0 after it, reached
+    from t: Newton steps (g' = Re sum coef lam e^(lam t)), bisecting the bracket where a step would leave it or g
+    does not fall. A row leaves the batch once its step is under rounding (SETTLED): the few slow rows do not
+    hold the many back."""
+    out, rows = t.copy(), np.arange(len(t))
+    coef_slope = coef * lam
     for _ in range(steps):
-        g, dg = slope_of(t)
+        e = np.exp(lam * t[:, None])
+        g = (coef * e).sum(axis=1).real - shift
+        dg = (coef_slope * e).sum(axis=1).real
         before = g > 0
         lo, hi = np.where(before, t, lo), np.where(before, hi, t)
         with np.errstate(divide="ignore", invalid="ignore"):
             newton = t - g / dg
         moved = np.where((dg < 0) & (newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
-        if np.all(np.abs(moved - t) <= SETTLED * (1.0 + np.abs(t))):  # every root to rounding (or no rows)
-            return moved
-        t = moved
-    return t
+        out[rows] = moved
+        going = np.abs(moved - t) > SETTLED * (1.0 + np.abs(t))
+        if not going.any():
+            break
+        if going.all():
+            t = moved
+            continue
+        rows, t, lo, hi, shift = rows[going], moved[going], lo[going], hi[going], shift[going]
+        coef, coef_slope, lam = coef[going], coef_slope[going], lam[going]
+    return out
 
 
-def top(lam: np.ndarray, a: np.ndarray, lo: np.ndarray, hi: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The top of |y| within [lo, hi] (K,) reached from t (y' = 0 there). Its time and |y| there."""
-    sign = np.where(values(lam, a, t) < 0, -1.0, 1.0)  # |y| = sign y near t
-
-    def slope(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        e = a * lam * np.exp(lam * t[:, None])
-        return sign * e.sum(axis=1).real, sign * (e * lam).sum(axis=1).real
-
-    t = _falling_root(slope, lo, hi, t, TOP_STEPS)
+def _refine_tops(
+    lam: np.ndarray, a: np.ndarray, t: np.ndarray, step: np.ndarray, sign: np.ndarray, offset: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Sampled tops of |y| (one per row: a sum's poles and parts, the sample's time, the samples' spacing, the
+    sign of y there and the vertex of the parabola through the three samples, in steps) refined to the top
+    (y' = 0) between the samples either side, from the vertex: their times and |y| there."""
+    lo, hi = np.maximum(t - step, 0.0), t + step
+    start = np.clip(t + offset * step, lo, hi)
+    t = _falling_root(sign[:, None] * a * lam, lam, np.zeros(len(t)), lo, hi, start, TOP_STEPS)
     return t, np.abs(values(lam, a, t))
 
 
@@ -82,9 +96,12 @@ def peak(lam: np.ndarray, a: np.ndarray, floor: np.ndarray) -> np.ndarray:
             break
         span = _window(lam[rows], a[rows], start, best[rows]) * (count / WINDOW_SAMPLES)
         step = span / count
-        times, v = _samples(lam[rows], a[rows], start, step, count)
+        times, y = _samples(lam[rows], a[rows], start, step, count)
+        v = np.abs(y)
         largest = np.maximum(best[rows], v.max(axis=1))
-        cell, _, tops = _tops(lam[rows], a[rows], times, v, step, v >= NEAR_PEAK * largest[:, None])
+        cell, k, offset = _sampled_tops(v, v >= NEAR_PEAK * largest[:, None])
+        sign = np.where(y[cell, k] < 0, -1.0, 1.0)
+        _, tops = _refine_tops(lam[rows[cell]], a[rows[cell]], times[cell, k], step[cell], sign, offset)
         np.maximum.at(largest, cell, tops)
         best[rows] = largest
         start = start + span
@@ -151,51 +168,56 @@ def _window(lam: np.ndarray, a: np.ndarray, at: np.ndarray, level: np.ndarray) -
 
 
 def _samples(lam: np.ndarray, a: np.ndarray, begin: np.ndarray, step: np.ndarray, count: int):
-    """Times begin + k step, k <= count, and |y| there: (K, count + 1) each."""
+    """Times begin + k step, k <= count, and y there: (K, count + 1) each."""
     times = begin[:, None] + step[:, None] * np.arange(count + 1)
-    return times, np.abs(grid_sums(lam, begin, step, count + 1, a[:, None])[:, 0].real)
+    return times, grid_sums(lam, begin, step, count + 1, a[:, None])[:, 0].real
 
 
-def _tops(lam: np.ndarray, a: np.ndarray, times: np.ndarray, v: np.ndarray, step: np.ndarray, wanted: np.ndarray):
-    """The sampled tops of |y| (v at ``times``, (K, N) evenly ``step`` apart) where ``wanted``, each refined
-    between the samples either side: their sums' indices, times and |y| (flat)."""
-    edge = np.full((len(v), 1), -np.inf)
-    sampled_top = (v >= np.c_[edge, v[:, :-1]]) & (v >= np.c_[v[:, 1:], edge])
-    cell, k = np.nonzero(sampled_top & wanted)
-    t = times[cell, k]
-    t_top, v_top = top(lam[cell], a[cell], np.maximum(t - step[cell], 0.0), t + step[cell], t)
-    return cell, t_top, v_top
+def _sampled_tops(v: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sampled tops of v = |y| (K, N) where ``wanted``: their rows, sample indices and the vertex of the
+    parabola through the sample and its neighbours (offset in samples, within +-1; 0 at either end)."""
+    v_before, v_after = np.full_like(v, -np.inf), np.full_like(v, -np.inf)
+    v_before[:, 1:], v_after[:, :-1] = v[:, :-1], v[:, 1:]
+    cell, k = np.nonzero((v >= v_before) & (v >= v_after) & wanted)
+    before, here, after = v_before[cell, k], v[cell, k], v_after[cell, k]
+    curvature = before - 2.0 * here + after
+    with np.errstate(divide="ignore", invalid="ignore"):
+        offset = np.where(np.isfinite(curvature) & (curvature < 0), 0.5 * (before - after) / curvature, 0.0)
+    return cell, k, np.clip(offset, -1.0, 1.0)
 
 
 def _scan(lam: np.ndarray, a: np.ndarray, begin: np.ndarray, end: np.ndarray, level: np.ndarray, count: int):
     """The last time in [begin, end] (K,) |y| reaches ``level`` (nan where it does not): ``count`` + 1
     samples, the sampled tops after the last sample above refined, the crossing after the last of these
-    above solved."""
+    above solved (from the line through |y| at either end of its bracket)."""
     step = (end - begin) / count
-    times, v = _samples(lam, a, begin, step, count)
+    times, y = _samples(lam, a, begin, step, count)
+    v = np.abs(y)
     K, rows = len(lam), np.arange(len(lam))
     above = v >= level[:, None]
     last = np.where(above.any(axis=1), count - np.argmax(above[:, ::-1], axis=1), -1)
     found = np.where(last >= 0, times[rows, np.maximum(last, 0)], -np.inf)
-    after = times[rows, np.minimum(last + 1, count)]
+    following = np.minimum(last + 1, count)
     wanted = (v >= NEAR_LEVEL * level[:, None]) & (np.arange(count + 1) > last[:, None])
-    cell, t_top, v_top = _tops(lam, a, times, v, step, wanted)  # a top between samples may reach the level
+    cell, k, offset = _sampled_tops(v, wanted)  # a top between samples may reach the level
+    sign = np.where(y[cell, k] < 0, -1.0, 1.0)
+    t_top, v_top = _refine_tops(lam[cell], a[cell], times[cell, k], step[cell], sign, offset)
     latest = np.full(K, -np.inf)
     reach = v_top >= level[cell]
     np.maximum.at(latest, cell[reach], t_top[reach])
     later = latest > found
-    following = np.ceil((latest[later] - begin[later]) / step[later])
-    found[later], after[later] = latest[later], times[later, np.clip(following, 0, count).astype(int)]
+    found[later] = latest[later]
+    following[later] = np.clip(np.ceil((latest[later] - begin[later]) / step[later]), 0, count).astype(int)
     done = np.isfinite(found)
-    lo, hi = found[done], np.maximum(after[done], found[done])
+    lo = found[done]
+    hi = np.maximum(times[done, following[done]], lo)
     lam, a, level = lam[done], a[done], level[done]
-    sign = np.where(values(lam, a, lo) < 0, -1.0, 1.0)  # |y| = sign y from lo until it falls through the level
-
-    def excess(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        e = a * np.exp(lam * t[:, None])
-        return sign * e.sum(axis=1).real - level, sign * (e * lam).sum(axis=1).real
-
-    crossing = _falling_root(excess, lo, hi, 0.5 * (lo + hi), CROSSING_STEPS)
+    y_lo = values(lam, a, lo)
+    sign = np.where(y_lo < 0, -1.0, 1.0)  # |y| = sign y from lo until it falls through the level
+    over, under = np.abs(y_lo) - level, v[done, following[done]] - level
+    with np.errstate(divide="ignore", invalid="ignore"):
+        start = np.where(over > under, lo + (hi - lo) * over / (over - under), 0.5 * (lo + hi))
+    crossing = _falling_root(sign[:, None] * a, lam, level, lo, hi, np.clip(start, lo, hi), CROSSING_STEPS)
     out = np.full(K, np.nan)
     out[done] = crossing
     return out

@@ -101,8 +101,8 @@ def modes_of(loop: LinearLoop, g_b: float | np.ndarray, g_m: float | np.ndarray)
     # Every mode's state through the push, its envelope after it, then the response where the loop is stable.
     steps = pulse_steps(kick, loop.dt)
     discrete = mu if loop.view == "discrete" else None
-    xi = pulse_states(seen, discrete, loop.dt, kick.duration, steps)  # (K, seen, J)
-    c, b = pulse_modes(seen, discrete, loop.dt, kick.duration)  # the same as modes, for y between the samples
+    c, b = pulse_modes(seen, discrete, loop.dt, kick.duration)  # the push as modes, for y between the samples
+    xi = pulse_states(seen, discrete, loop.dt, kick.duration, steps, (c, b))  # (K, seen, J)
     after = kick.peak * y_gain * xi[..., -1]
     pair = np.abs(fold_pairs(seen, after))
     pair = np.where(seen.imag < 0, np.abs(2 * after), pair)  # the lower pole shows its pair's amplitude too
