@@ -343,16 +343,21 @@ class FsmsScene:
         self.base_callout.attach(base.rotation, base.translation, np.asarray(self.style.base_label, dtype=float))
 
     def _add_labels(self) -> Callout:
-        """The names written in the scene; returns the base's callout (its label writes the drawn factor)."""
-        scene, st = self.server.scene, self.style
+        """The names written in the scene, all callouts (placed off the arm, each other and the page's edges);
+        returns the base's (its label writes the drawn factor). The fixed parts' points are in their root
+        node's frame, which is the world's."""
+        st = self.style
         label = self.callouts.add("base", base_label(1.0), parent=self.BASE)
+        fixed: tuple[str, str, tuple[float, float, float]] | None = None
         if isinstance(st.base, DoubleBeamStyle):
-            scene.add_label("/beam/label", "clamp", position=(0.0, -0.05, 0.04), anchor="bottom-center")
+            fixed = ("/beam", "clamp", (0.0, -0.05, 0.04))
         elif isinstance(st.base, BoomStyle):
-            scene.add_label("/boom/label", "clamp", position=(0.0, 0.0, 2.0 * st.base.radius), anchor="bottom-center")
+            fixed = ("/boom", "clamp", (0.0, 0.0, 2.0 * st.base.radius))
         elif isinstance(st.base, CartSpringStyle):
-            middle = 0.5 * (st.base.wall_x + st.base.attach[0])
-            scene.add_label("/spring/label", "spring k_b", position=(middle, 0.0, 0.05))
+            fixed = ("/spring", "spring k_b", (0.5 * (st.base.wall_x + st.base.attach[0]), 0.0, 0.05))
+        if fixed is not None:
+            root, text, point = fixed
+            self.callouts.add(text.split()[0], text, parent=root).attach(np.eye(3), np.zeros(3), np.array(point))
         return label
 
 

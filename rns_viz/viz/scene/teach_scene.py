@@ -22,6 +22,7 @@ from rns_viz.viz.scene.view_toggles import ViewToggles
 L_COLOUR = (120, 40, 170)  # purple: coupling momentum
 N_COLOUR = (235, 130, 0)  # orange: null-space direction at the hand
 OUTLINE_COLOUR = (110, 60, 190)  # the reachable region's edge, darker than its dots
+EDGE_TEXT = "edge of the reactionless region: a fold, J̄ loses rank"
 PATH_ARROWS = 8  # arrowheads along the current path
 L_REF_RATE = 1.0  # rad/s: a joint rate that draws L at full arrow length (with sigma_min(S H_bm) at the start)
 
@@ -61,12 +62,14 @@ class TeachScene:
             OUTLINE_COLOUR,
             point_size=0.6 * r,
             point_shape="circle",
-            position=(0.0, 0.0, st.overlay_z - 0.5 * r),  # just above the region's dots
+            position=(0.0, 0.0, st.overlay_z - 0.5 * r),  # just above the region's dots (_outline_offset)
             visible=False,
         )
-        self.outline_label = server.scene.add_label(
-            f"{self.OUTLINE}/label", "edge of the reactionless region: a fold, J̄ loses rank", visible=False
-        )
+        # the edge's name: a callout placed off the arm and inside every page (its point: the edge's top)
+        self.edge_callout = scene.callouts.add("region_edge", EDGE_TEXT, parent=self.OUTLINE)
+        self.edge_callout.shown = False
+        self._edge_top = np.zeros(3)  # m, in the outline node's frame
+        self._outline_offset = np.array([0.0, 0.0, st.overlay_z - 0.5 * r])  # the outline node in the base's frame
         self._has_path = False
         self.has_reach = False  # the reachable set is drawn (set by the renderer with the overlays)
         self.reaction_label = "arm reaction"
@@ -90,6 +93,10 @@ class TeachScene:
     def draw(self, snap: Snapshot, q_shadow: np.ndarray | None, exaggeration: float, view: ViewToggles) -> None:
         """Ghost (``q_shadow`` as drawn, or None), L and n for the snapshot; hidden parts cost nothing."""
         self._apply_toggles(snap, view)
+        if self.edge_callout.shown:  # tied to the drawn base, as the outline node is
+            base = self.scene.robot.base_placement()
+            at = base.translation + base.rotation @ self._outline_offset
+            self.edge_callout.attach(base.rotation, at, self._edge_top)
         self.ghost.update(q_shadow if view.on("ghost") else None, exaggeration, self._shadow_label(snap))
         self._draw_coupling(snap.readouts.L if view.on("coupling") else None)
         theta = snap.q[self.model.m :]
@@ -116,7 +123,7 @@ class TeachScene:
         if view.on("reach") != sc.show_reach:
             sc.show_reach = view.on("reach")
             sc.reachable.visible = sc.show_reach and self.has_reach
-            self.outline.visible = self.outline_label.visible = sc.show_reach and self.has_reach
+            self.outline.visible = self.edge_callout.shown = sc.show_reach and self.has_reach
 
     def _draw_coupling(self, L: float | None) -> None:
         if L is None or not np.isfinite(L):
@@ -172,8 +179,8 @@ class TeachScene:
             if len(edge):
                 self.outline.points = edge.astype(np.float32)
                 self.outline.colors = np.array(OUTLINE_COLOUR, dtype=np.uint8)
-                self.outline_label.position = edge[int(np.argmax(edge[:, 1]))] + np.array([0.0, 0.0, 0.05])
-            self.outline.visible = self.outline_label.visible = show
+                self._edge_top = edge[int(np.argmax(edge[:, 1]))]
+            self.outline.visible = self.edge_callout.shown = show
 
     def set_path(self, curve: np.ndarray | None) -> None:
         """Arrowheads along the current path's end-effector curve (base frame, in path order = increasing ū)."""

@@ -45,7 +45,6 @@ TARGET_HANDLE = f"{FsmsScene.BASE_AT_REST}/target_handle"  # at rest: the page d
 REACTION_LABEL = "arm reaction"
 KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
 # the names written in the scene that the *Labels* toggle hides (arrows' labels follow their arrows)
-LABELS = ("/beam/label", "/boom/label", "/spring/label")  # and the callouts: the base's, "drag me", the ghost's
 
 
 class Renderer:
@@ -207,15 +206,9 @@ class Renderer:
             self._update_text(snap)
 
     def _apply_view(self) -> None:
-        """The toggles of *Show in the scene* the render thread owns: labels, other paths, the gain map."""
+        """The toggles of *Show in the scene* the render thread owns: other paths, the gain map (the labels:
+        the callouts read theirs each frame)."""
         seen, view = self._seen, self.view
-        labels = view.on("labels")
-        if labels != seen.labels:
-            seen.labels = labels
-            for name in LABELS:
-                handle = self.server.scene.get_handle_by_name(name)
-                if handle is not None:
-                    handle.visible = labels
         paths = view.on("paths")
         if paths != seen.paths:
             seen.paths = paths
@@ -388,5 +381,4 @@ class _Seen:
         self.next_plot = 0.0
         self.next_text = 0.0
         self.plot_mode = ""
-        self.labels: bool | None = None  # the view toggles last applied
         self.paths: bool | None = None
