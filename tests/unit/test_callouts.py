@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.scene.callout_layout import (
+    CELL_PX,
     Occupancy,
     PageCamera,
     Placement,
@@ -131,3 +132,30 @@ def test_a_place_that_is_no_longer_free_is_given_up() -> None:
     page = Occupancy(cam.width, cam.height)
     page.add_solid(cam.project(wall)[0])
     assert page.taken(_label_box(cam, item)) == 0
+
+
+def test_taken_cells_counted_as_the_cells_under_the_box_after_every_addition() -> None:
+    """The summed-area count of taken cells equals a direct count over the box's cells, also right after
+    a solid or a box is added (a stale table would count the cells before the addition)."""
+    rng = np.random.default_rng(7)
+    page = Occupancy(333, 217)
+    for _ in range(20):
+        if rng.random() < 0.5:
+            page.add_solid(rng.uniform([0, 0], [333, 217], size=(8, 2)))
+        else:
+            x, y = rng.uniform(-20, 330), rng.uniform(-20, 210)
+            page.add_box(np.array([x, y, x + rng.uniform(0, 60), y + rng.uniform(0, 40)]))
+        for _ in range(25):
+            x0, y0 = rng.uniform(-30, 340), rng.uniform(-30, 220)
+            box = np.array([x0, y0, x0 + rng.uniform(-5, 120), y0 + rng.uniform(-5, 80)])
+            i0, j0, i1, j1 = (
+                int(np.clip(f(v / CELL_PX), 0, n))
+                for v, f, n in zip(
+                    box,
+                    (math.floor, math.floor, math.ceil, math.ceil),
+                    (page.cells.shape[1], page.cells.shape[0]) * 2,
+                    strict=True,
+                )
+            )
+            want = int(np.count_nonzero(page.cells[j0:j1, i0:i1])) if i1 > i0 and j1 > j0 else 0
+            assert page.taken(box) == want, box

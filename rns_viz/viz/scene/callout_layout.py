@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -46,7 +47,7 @@ class PageCamera:
     shown: tuple[float, float] | None = None  # px: the rows not under a panel (a phone's sheet); None: all
     covered: tuple[float, float, float, float] | None = None  # px: a box a floating panel covers (x0, y0, x1, y1)
 
-    @property
+    @cached_property  # (frozen: a page's camera does not change; read for every candidate place)
     def focal(self) -> float:
         return 0.5 * self.height / math.tan(0.5 * self.fov)
 
@@ -76,8 +77,8 @@ def box_at(point: np.ndarray, anchor: str, size: tuple[float, float]) -> np.ndar
     sits there: 'bottom-left' puts the box above and right of it)."""
     w, h = size
     vertical, horizontal = anchor.split("-")
-    x0 = point[0] - {"left": 0.0, "center": 0.5 * w, "right": w}[horizontal]
-    y0 = point[1] - {"top": 0.0, "center": 0.5 * h, "bottom": h}[vertical]
+    x0 = float(point[0]) - {"left": 0.0, "center": 0.5 * w, "right": w}[horizontal]
+    y0 = float(point[1]) - {"top": 0.0, "center": 0.5 * h, "bottom": h}[vertical]
     return np.array([x0, y0, x0 + w, y0 + h])
 
 
@@ -110,6 +111,7 @@ class Occupancy:
         self.width, self.height = width, height
         self.top, self.bottom = shown if shown is not None else (0.0, float(height))
         self.cells = np.zeros((max(1, math.ceil(height / CELL_PX)), max(1, math.ceil(width / CELL_PX))), dtype=bool)
+        self._sums: np.ndarray | None = None  # the taken cells' summed-area table, built at the first count
 
     def add_solid(self, corners_px: np.ndarray) -> None:
         """Take the cells under the convex hull of one solid's projected corners (k, 2) (nan: behind the page)."""
@@ -136,27 +138,39 @@ class Occupancy:
                 length = float(np.hypot(*edge)) or 1.0
                 inside &= (edge[0] * (Y - a[1]) - edge[1] * (X - a[0])) / length >= -grow
         self.cells[lo[1] : hi[1], lo[0] : hi[0]] |= inside
+        self._sums = None
 
     def add_box(self, box: np.ndarray, grow: float = 0.0) -> None:
         i0, j0, i1, j1 = self._index(np.asarray(box, dtype=float) + np.array([-grow, -grow, grow, grow]))
         self.cells[j0:j1, i0:i1] = True
+        self._sums = None
 
     def taken(self, box: np.ndarray) -> int:
         """How many taken cells the box (x0, y0, x1, y1) px covers."""
         i0, j0, i1, j1 = self._index(box)
-        return int(np.count_nonzero(self.cells[j0:j1, i0:i1]))
+        if i1 <= i0 or j1 <= j0:
+            return 0
+        if self._sums is None:  # a layout counts hundreds of boxes between two additions
+            self._sums = np.zeros((self.cells.shape[0] + 1, self.cells.shape[1] + 1), dtype=np.int64)
+            self._sums[1:, 1:] = self.cells.cumsum(axis=0).cumsum(axis=1)
+        t = self._sums
+        return int(t[j1, i1] - t[j0, i1] - t[j1, i0] + t[j0, i0])
 
     def inside(self, box: np.ndarray) -> bool:
-        x0, y0, x1, y1 = box
+        x0, y0, x1, y1 = box.tolist()  # (Python floats: compared many times per layout)
         return bool(
             x0 >= EDGE_PX and y0 >= self.top + EDGE_PX and x1 <= self.width - EDGE_PX and y1 <= self.bottom - EDGE_PX
         )
 
     def _index(self, box: np.ndarray) -> tuple[int, int, int, int]:
         rows, cols = self.cells.shape
-        i0, j0 = (int(np.clip(math.floor(v / CELL_PX), 0, n)) for v, n in ((box[0], cols), (box[1], rows)))
-        i1, j1 = (int(np.clip(math.ceil(v / CELL_PX), 0, n)) for v, n in ((box[2], cols), (box[3], rows)))
-        return i0, j0, i1, j1
+        x0, y0, x1, y1 = (float(v) / CELL_PX for v in box)
+        return (
+            min(max(math.floor(x0), 0), cols),
+            min(max(math.floor(y0), 0), rows),
+            min(max(math.ceil(x1), 0), cols),
+            min(max(math.ceil(y1), 0), rows),
+        )
 
 
 def _segment_distance(X: np.ndarray, Y: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

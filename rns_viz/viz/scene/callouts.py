@@ -20,6 +20,7 @@ import viser
 import viser.transforms as vtf
 
 from rns_viz.viz.scene.callout_layout import (
+    CELL_PX,
     GAP_PX,
     Occupancy,
     PageCamera,
@@ -32,7 +33,7 @@ from rns_viz.viz.scene.callout_layout import (
 from rns_viz.viz.scene.framing import band_for, main_panel_box
 
 LAYOUT_S = 0.25  # s between layouts (while the view or the arm moves; none while both stand still)
-STILL_PX = 1.0  # a layout is skipped while no page's projected point or solid moved more than this
+STILL_PX = 0.5 * CELL_PX  # a layout is skipped while no page's projected point or solid moved more than this (px)
 LEADER_COLOUR = (90, 90, 90)
 
 
@@ -100,20 +101,21 @@ class Callouts:
     def frame(
         self,
         now: float,
-        pages: Sequence[PageCamera],
+        pages: Callable[[], Sequence[PageCamera]],
         solids: Callable[[], np.ndarray],
         labels_on: bool,
     ) -> None:
-        """Place the callouts if it is time (``pages``: primary first; ``solids()``: (L, 8, 3) world corners
-        of what no label may cover) and send what changed."""
+        """Place the callouts if it is time (``pages()``: the pages' cameras, primary first; ``solids()``:
+        (L, 8, 3) world corners of what no label may cover) and send what changed."""
         live = [c for c in self.items.values() if labels_on and c.shown and _finite(c.point)]
-        if live and pages and now >= self.next_layout:
+        if live and now >= self.next_layout:
             self.next_layout = now + LAYOUT_S
-            corners = solids()
-            seen = self._seen(live, pages, corners)
-            if not self._same(seen):
+            cameras = pages()
+            corners = solids() if cameras else None
+            seen = self._seen(live, cameras, corners) if corners is not None else None
+            if seen is not None and corners is not None and not self._same(seen):
                 self._laid_out = seen
-                self._layout(live, pages, corners)
+                self._layout(live, cameras, corners)
         for item in self.items.values():
             self._draw(item, item in live)
 

@@ -50,7 +50,7 @@ class SceneCallouts:
         if self.ghost_name.shown:
             hand = self.ghost.robot.data.oMi[self.hand_joint]
             self.ghost_name.attach(hand.rotation, hand.translation, self.hand_point)
-        self.callouts.frame(now, self.pages(), self.solids, labels_on)
+        self.callouts.frame(now, self.pages, self.solids, labels_on)
 
     def pages(self) -> list[PageCamera]:
         """The pages' cameras, the operator's first (then by connection order)."""
