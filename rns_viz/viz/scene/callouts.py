@@ -49,7 +49,7 @@ def page_camera(client: viser.ClientHandle) -> PageCamera | None:
     return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width))
 
 
-@dataclass
+@dataclass(eq=False)  # one callout is itself only (``in`` must not compare its arrays)
 class Callout:
     """One label and its leader under a parent node; the owner calls :meth:`attach` and sets ``text`` and
     ``shown`` each frame."""
