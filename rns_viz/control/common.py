@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Literal, NamedTuple, Protocol
 
 import numpy as np
 
+from rns_viz.lapack import solve
 from rns_viz.model import FsmsModel
 
 if TYPE_CHECKING:
@@ -306,7 +307,7 @@ def _any_base_torques(
     """:func:`realize_acceleration` for an m-DOF base, as written there."""
     m, M, c = model.m, cp.M, cp.c
     rhs = -model.K_b @ q[:m] - model.D_b @ v[:m] - c[:m] - M[:m, m:] @ thetaddot
-    tau = M[:m, m:].T @ np.linalg.solve(M[:m, :m], rhs) + M[m:, m:] @ thetaddot + c[m:]
+    tau = M[:m, m:].T @ solve(M[:m, :m], rhs) + M[m:, m:] @ thetaddot + c[m:]
     if model.has_joint_damping:
         tau += model.D_m @ v[m:]
     return tau
