@@ -1,12 +1,14 @@
 """Benchmark: the Python closed-loop step of this tree against another checkout of rns_viz, same minute.
 
-Run on demand:  python benchmarks/bench_step_vs.py OTHER_TREE [--rounds 7] [--steps 3000]
+Run on demand:  python benchmarks/bench_step_vs.py OTHER_TREE [--rounds 7] [--steps 3000] [--shadow]
 
 OTHER_TREE is the root of another checkout (e.g. a git worktree of an older commit). The step timed
 is ``Simulator.step()`` with ``native=False`` (law and RK4 in Python + pinocchio), law (15)
 ``AccelerationLaw`` with ``Gains(g_b=10, g_m=1)`` and its default null input, RK4 at 1 ms, logging
 on, starting at the model's default configuration with v0 = (0.01, 0, ...), for TREP, the 3R and
 the generated 7-DOF arm of ``benchmarks/oracles.py`` (arm7) and boom7 (13 DOF, six coupling rows).
+``--shadow``: the law without its G_b term (``suppress=False``), as the app's shadow run of a suppressing
+run steps; the law is then evaluated at every RK4 stage (four times per step).
 Also printed: the largest relative difference between the two trees' states after each round's
 steps (the same steps must give the same numbers: 0 for a pure speed-up).
 
@@ -35,7 +37,7 @@ import numpy as np
 MODELS = ("trep", "planar3r", "arm7", "boom7")
 
 
-def worker(steps: int, arm7_toml: str, models: tuple[str, ...]) -> None:
+def worker(steps: int, arm7_toml: str, models: tuple[str, ...], suppress: bool = True) -> None:
     """Serve rounds: for each line on stdin, time ``steps`` Python steps per model with the rns_viz found on
     sys.path (a fresh simulator each round) and print µs/step (wall, CPU) and the final state as one JSON line."""
     import numpy as np
@@ -53,7 +55,7 @@ def worker(steps: int, arm7_toml: str, models: tuple[str, ...]) -> None:
 
     def simulator(name: str) -> Simulator:
         model, q0, v0 = starts[name]
-        law = AccelerationLaw(model, Gains(g_b=10.0, g_m=1.0))
+        law = AccelerationLaw(model, Gains(g_b=10.0, g_m=1.0), suppress=suppress)
         return Simulator(model, law, q0=q0, v0=v0, log_capacity=steps + 1, native=False)
 
     for name in models:
@@ -75,12 +77,12 @@ def worker(steps: int, arm7_toml: str, models: tuple[str, ...]) -> None:
 class Worker:
     """A subprocess running :func:`worker` with ``tree`` first on its path; :meth:`round` times one round."""
 
-    def __init__(self, tree: Path, steps: int, arm7_toml: Path, models: tuple[str, ...]) -> None:
+    def __init__(self, tree: Path, steps: int, arm7_toml: Path, models: tuple[str, ...], shadow: bool) -> None:
         env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}  # leave the other tree as it is
         command = [sys.executable, str(Path(__file__).resolve()), str(tree), "--worker", str(arm7_toml)]
         self.tree = tree
         self.process = subprocess.Popen(
-            [*command, "--steps", str(steps), "--models", ",".join(models)],
+            [*command, "--steps", str(steps), "--models", ",".join(models), *(["--shadow"] if shadow else [])],
             cwd=tree,
             env=env,
             stdin=subprocess.PIPE,
@@ -111,13 +113,14 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--steps", type=int, default=3000, help="timed steps per model and round")
     parser.add_argument("--models", default=",".join(MODELS), help="comma-separated; an older checkout may lack boom7")
+    parser.add_argument("--shadow", action="store_true", help="the law without G_b (the app's shadow run)")
     parser.add_argument("--worker", metavar="ARM7_TOML", help=argparse.SUPPRESS)
     args = parser.parse_args()
     models = tuple(args.models.split(","))
     if unknown := set(models) - set(MODELS):
         parser.error(f"unknown models {sorted(unknown)}; choose from {', '.join(MODELS)}")
     if args.worker:
-        worker(args.steps, args.worker, models)
+        worker(args.steps, args.worker, models, suppress=not args.shadow)
         return
 
     here = Path(__file__).resolve().parent.parent
@@ -132,7 +135,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "arm7.urdf").write_text(arm7_urdf())
         (Path(tmp) / "arm7.toml").write_text(ARM7_TOML)
-        workers = {tree: Worker(path, args.steps, Path(tmp) / "arm7.toml", models) for tree, path in trees.items()}
+        workers = {
+            tree: Worker(path, args.steps, Path(tmp) / "arm7.toml", models, args.shadow) for tree, path in trees.items()
+        }
         for r in range(args.rounds):
             order = list(trees) if r % 2 == 0 else list(reversed(trees))
             for tree in order:
@@ -144,7 +149,8 @@ def main() -> None:
             w.close()
 
     load = ", ".join(f"{x:.2f}" for x in (*load_before, *os.getloadavg()))
-    print(f"Python step (native=False), law (15) g_b=10 g_m=1, RK4 1 ms, {args.steps} steps x {args.rounds} rounds")
+    law = "law (15) g_m=1 without G_b (shadow run)" if args.shadow else "law (15) g_b=10 g_m=1"
+    print(f"Python step (native=False), {law}, RK4 1 ms, {args.steps} steps x {args.rounds} rounds")
     print(f"this: {trees['this']}\nother: {trees['other']}")
     print(f"load average (1, 5, 15 min) before, after: {load}")
     header = ("model", "clock", "this min", "median", "other min", "median", "ratio min", "median")

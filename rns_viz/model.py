@@ -121,7 +121,8 @@ class FsmsModel:
         weights = np.where(turning, 1.0 / self.arm_reach, 1.0)
         self.coupling_weights: np.ndarray | None = weights if turning.any() else None
         # c_b = H_bm' theta' exactly (M does not depend on x_b): see dynamics()
-        self.cb_is_hbm_dot = self.base_is_translational and not np.any(spec.gravity)
+        self.gravity_free = not np.any(spec.gravity)
+        self.cb_is_hbm_dot = self.base_is_translational and self.gravity_free
         # ee_kinematics: its buffers, the task rows as a slice where they are contiguous, and
         # whether the base frame is the world's axes at every x_b (translating, no rotated origin)
         self._v_rel, self._zero_v = np.zeros(model.nv), np.zeros(model.nv)
@@ -204,14 +205,16 @@ class FsmsModel:
         Runs at every control step. M and c are new arrays; H_bm' theta' may be a view of c.
 
         For a translating base without gravity c_b is exactly H_bm' theta' (M does not depend
-        on x_b), which saves the Coriolis matrix; otherwise H_bm' comes from M' = C + C^T.
+        on x_b), which saves the Coriolis matrix; otherwise H_bm' comes from M' = C + C^T, and
+        without gravity c = C v from the same C (no second pass for nonLinearEffects).
         """
         model, data, m = self.pin_model, self.data, self.m
         M = pin.crba(model, data, q)  # pinocchio returns new arrays: nothing to copy
-        c = pin.nonLinearEffects(model, data, q, v)
         if self.cb_is_hbm_dot:
+            c = pin.nonLinearEffects(model, data, q, v)
             return M, c, c[:m]  # a view of c
         C = pin.computeCoriolisMatrix(model, data, q, v)
+        c = C.dot(v) if self.gravity_free else pin.nonLinearEffects(model, data, q, v)
         return M, c, (C + C.T)[:m, m:] @ v[m:]
 
     def terms(self, q: np.ndarray, v: np.ndarray) -> Terms:

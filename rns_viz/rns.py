@@ -2,7 +2,8 @@
 singularity, and the one RK4 step that integrates a field of the RNS distribution (n, n u-bar, P_RNS v).
 Whether the distribution is integrable (Lie brackets): :mod:`rns_viz.integrability`.
 
-Pure numpy on matrices that the model supplies; no pinocchio, no viser.
+numpy on matrices that the model supplies (the per-step SVD and solve by LAPACK directly, rns_viz.lapack);
+no pinocchio, no viser.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ from functools import cache
 from typing import Any
 
 import numpy as np
+
+from rns_viz.lapack import singular_values, solve
 
 # Default singularity-robust settings: below ``threshold`` (smallest singular value, in the units
 # of the matrix) damping rises smoothly to ``max_damping`` (Nakamura & Hanafusa, 1986).
@@ -142,12 +145,12 @@ def _damping_squared(sigma: float, threshold: float, max_damping: float) -> floa
 def _any_rows(A: np.ndarray, threshold: float, max_damping: float, weights: np.ndarray | None = None) -> DampedInverse:
     """Any number of rows: sigma_min from the SVD, then A^T G^-1 = (G^-1 A)^T with G = A A^T + lambda^2 E
     symmetric (one solve). ``weights`` (a column, A = W B already weighted): (G^-1 A)^T W, B's weighted inverse."""
-    sigma = float(np.linalg.svd(A, compute_uv=False)[-1])
+    sigma = singular_values(A).item(-1)
     lam2 = _damping_squared(sigma, threshold, max_damping)
     G = A @ A.T
     if lam2:
         G += lam2 * _identity(A.shape[0])
-    solved = np.linalg.solve(G, A)
+    solved = solve(G, A)
     inverse = (solved if weights is None else solved * weights).T
     return DampedInverse(inverse, sigma, math.sqrt(lam2))
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Literal, NamedTuple, Protocol
 
 import numpy as np
 
+from rns_viz.lapack import solve
 from rns_viz.model import FsmsModel
 
 if TYPE_CHECKING:
@@ -303,10 +304,12 @@ def realize_acceleration(
 def _any_base_torques(
     model: FsmsModel, cp: Coupling, q: np.ndarray, v: np.ndarray, thetaddot: np.ndarray
 ) -> np.ndarray:
-    """:func:`realize_acceleration` for an m-DOF base, as written there."""
-    m, M, c = model.m, cp.M, cp.c
-    rhs = -model.K_b @ q[:m] - model.D_b @ v[:m] - c[:m] - M[:m, m:] @ thetaddot
-    tau = M[:m, m:].T @ np.linalg.solve(M[:m, :m], rhs) + M[m:, m:] @ thetaddot + c[m:]
+    """:func:`realize_acceleration` for an m-DOF base, as written there, with z = M (0, theta'') + c formed
+    once: its base rows are c_b + H_bm theta'', its arm rows H_m theta'' + c_m (fewer numpy calls)."""
+    m, M = model.m, cp.M
+    z = M[:, m:].dot(thetaddot) + cp.c
+    rhs = -model.K_b @ q[:m] - model.D_b @ v[:m] - z[:m]
+    tau = M[m:, :m].dot(solve(M[:m, :m], rhs)) + z[m:]  # H_bm^T x_b'' + ..., M symmetric
     if model.has_joint_damping:
         tau += model.D_m @ v[m:]
     return tau

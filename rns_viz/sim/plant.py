@@ -30,7 +30,14 @@ class Plant:
         self._m = m
         self._u = np.zeros(nv)  # generalised force tau_gen, rebuilt for each evaluation
         self._K, self._D, self._Dm = model.K_b, model.D_b, np.diag(model.D_m).copy()
-        self._minus_K = -self._K  # (-K_b) x_b per evaluation: the negation done once
+        # (-K_b, 0, -D_b, 0): the base rows of tau_gen, -K_b x_b - D_b x_b', as one product with the
+        # stacked state (q, v) into u's first m entries (one call per RK4 stage instead of five)
+        self._spring_damper = np.zeros((m, 2 * nv))
+        self._spring_damper[:, :m] = -self._K
+        self._spring_damper[:, nv : nv + m] = -self._D
+        self._u_base = self._u[:m]
+        self._held_x = np.zeros(2 * nv)  # (q, v) stacked for held_acceleration
+        self._held_q, self._held_v = self._held_x[:nv], self._held_x[nv:]
         self._scalar_base = m == 1
         self._k, self._d = float(self._K[0, 0]), float(self._D[0, 0])
         self._arm_damped = bool(np.any(self._Dm))
@@ -60,15 +67,24 @@ class Plant:
 
     def held_acceleration(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Generalised acceleration (x_b'', theta'') at (q, v) for the inputs set by :meth:`hold`."""
-        m, u = self._m, self._u
-        if self._scalar_base:
-            u[0] = -self._k * q.item(0) - self._d * v.item(0) + self._f0
-        else:
-            u[:m] = self._minus_K @ q[:m] - self._D @ v[:m]
-            if self._f is not None:
-                u[:m] += self._f
+        if not self._scalar_base:
+            self._held_q[:] = q
+            self._held_v[:] = v
+            return self._stacked_acceleration(self._held_x, self._held_q, self._held_v)
+        u = self._u
+        u[0] = -self._k * q.item(0) - self._d * v.item(0) + self._f0
         if self._arm_damped:
-            u[m:] = self._tau - self._Dm * v[m:]
+            u[1:] = self._tau - self._Dm * v[1:]
+        return pin.aba(self._pin_model, self._data, q, v, u)
+
+    def _stacked_acceleration(self, x: np.ndarray, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """:meth:`held_acceleration` of an m-DOF base at x = (q, v), given with its views q and v."""
+        u = self._u
+        np.dot(self._spring_damper, x, self._u_base)
+        if self._f is not None:
+            self._u_base += self._f
+        if self._arm_damped:
+            u[self._m :] = self._tau - self._Dm * v[self._m :]
         return pin.aba(self._pin_model, self._data, q, v, u)
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, f_ext: np.ndarray | None) -> np.ndarray:
@@ -108,17 +124,32 @@ class Plant:
             if torque_at is not None:  # a servo at every stage: the general stages, the torque set per stage
                 return self._rk4_staged_scalar_base(x, samples, dt, torque_at)  # type: ignore[arg-type]
             return self._rk4_scalar_base(x, samples, dt)  # type: ignore[arg-type]
+        return self._rk4_any_base(x, f_ext if sampled else None, dt, torque_at)  # type: ignore[arg-type]
+
+    def _rk4_any_base(
+        self, x: np.ndarray, samples: StageForces | None, dt: float, torque_at: StageTorque | None
+    ) -> np.ndarray:
+        """:meth:`rk4_state_step` for an m-DOF base, inputs set by :meth:`hold`: each stage's acceleration
+        (:meth:`_stacked_acceleration`) from the stage's row of the buffer, everything it reads bound once."""
         q, v, a, xs, k = self._stage_q, self._stage_v, self._stage_a, self._stage_x, self._stage_k
+        aba, pin_model, data, u, dot, add = pin.aba, self._pin_model, self._data, self._u, np.dot, np.add
+        base, spring_damper, m, D_m, damped = self._u_base, self._spring_damper, self._m, self._Dm, self._arm_damped
+        f = self._f  # f(t); with samples, f(t + dt/2) for k_2, k_3 and f(t + dt) for k_4
+        forces = (f, f, f, f) if samples is None else (f, samples[1], samples[1], samples[2])
         xs[0][:] = x
-        for s, c in enumerate((0.5 * dt, 0.5 * dt, dt)):
-            a[s][:] = self.held_acceleration(q[s], v[s])
-            np.add(x, c * k[s], out=xs[s + 1])
-            if sampled and s != 1:  # k_2 and k_3 at t + dt/2, k_4 at t + dt
-                self._set_force(f_ext[s // 2 + 1])  # type: ignore[index]
-            if torque_at is not None:
-                self._set_torque(torque_at(c, q[s + 1], v[s + 1]))
-        a[3][:] = self.held_acceleration(q[3], v[3])
-        return x + self._weights(dt)[0].dot(self._slopes)
+        weights, steps = self._weights(dt)
+        for s, c in enumerate(steps):
+            dot(spring_damper, xs[s], base)
+            if forces[s] is not None:
+                base += forces[s]
+            if damped:
+                u[m:] = self._tau - D_m * v[s][m:]
+            a[s][:] = aba(pin_model, data, q[s], v[s], u)
+            if c is not None:
+                add(x, c * k[s], xs[s + 1])
+                if torque_at is not None:
+                    self._set_torque(torque_at(c, q[s + 1], v[s + 1]))
+        return x + weights.dot(self._slopes)
 
     def _set_torque(self, tau: np.ndarray) -> None:
         self._tau = tau

@@ -60,6 +60,23 @@ def test_velocity_terms_match_finite_differences(name: str, bundled_model: Calla
         np.testing.assert_allclose(terms.coupling_momentum, terms.H_bm @ thetadot, atol=1e-15)
 
 
+@pytest.mark.parametrize("name", ["trep", "boom7"])
+def test_step_dynamics_are_the_terms(name: str, bundled_model: Callable[[str], FsmsModel]) -> None:
+    """dynamics(), which the laws call at every step, gives terms()'s M, c (pinocchio's RNEA) and H_bm' theta':
+    on boom7 (a turning base without gravity) c is C v from the Coriolis matrix that gives M' = C + C^T."""
+    model = bundled_model(name)
+    m = model.m
+    for _ in range(20):
+        q, v = random_state(model)
+        terms = model.terms(q, v)
+        M, c, hbm_dot = model.dynamics(q, v)
+        np.testing.assert_array_equal(M[:m, m:], terms.H_bm)
+        np.testing.assert_array_equal(M[m:, m:], terms.H_m)
+        c_rnea = np.concatenate([terms.c_b, terms.c_m])
+        np.testing.assert_allclose(c, c_rnea, rtol=0, atol=1e-13 * np.abs(c_rnea).max())
+        np.testing.assert_allclose(hbm_dot, terms.hbm_dot_thetadot, rtol=0, atol=1e-13 * np.abs(c_rnea).max())
+
+
 def test_jacobian_and_ee_match_forward_kinematics(trep: FsmsModel, planar3r: FsmsModel) -> None:
     eps = 1e-7
     for model, fk in ((trep, trep_ee), (planar3r, r3_ee)):
