@@ -19,7 +19,7 @@ import pytest
 
 from rns_viz.live.loop.session import Session
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp
-from rns_viz.viz.server.classroom import Classroom, start_classroom
+from rns_viz.viz.server.classroom import Classroom, default_visitor_cap, start_classroom
 from rns_viz.viz.server.page_rate import FULL_HZ, SLOW_ANSWER_S
 from tests.support.app_helpers import uuid
 from tests.support.browser import live_group, wait_until
@@ -225,3 +225,12 @@ def test_a_slow_page_gets_fewer_updates_of_its_own_simulation_and_a_fast_page_al
         fast.close()
     finally:
         room.stop()
+
+
+def test_the_default_cap_follows_the_cores_and_the_step() -> None:
+    """More simulations with the native step (a fifth of a core each, measured) than with the Python step,
+    one interpreter's worth at most whatever the cores, never none."""
+    assert default_visitor_cap(1, native=False) == 1 and default_visitor_cap(2, native=False) == 2
+    assert default_visitor_cap(2, native=True) == 5 and default_visitor_cap(1, native=True) == 2
+    assert default_visitor_cap(64, native=False) == 3 and default_visitor_cap(64, native=True) == 5
+    assert default_visitor_cap(None, native=None) >= 1  # this machine, whatever it has

@@ -37,7 +37,8 @@ def test_memory_stays_bounded_over_a_long_run() -> None:
         after = tracemalloc.take_snapshot().filter_traces(ours)
         tracemalloc.stop()
         grown = sum(d.size_diff for d in after.compare_to(before, "filename"))
-        assert grown < 1_000_000, f"{grown} bytes more after 5 s more of simulation"
+        where = [str(d) for d in after.compare_to(before, "traceback")[:3]]  # the largest growths, to look at
+        assert grown < 1_000_000, f"{grown} bytes more after 5 s more of simulation; largest: {where}"
         assert len(s.latencies()) <= 2000 and len(s.plot_arrays()["t"]) == 500
         assert len(s.state.runs.kicks.pulses) <= 1  # ended pulses are dropped
     finally:

@@ -30,17 +30,21 @@ import viser
 import viser._messages as viser_messages
 
 from rns_viz.live.loop.session import Session
+from rns_viz.sim import native as native_step
 from rns_viz.viz.clients.client_view import ClientView
 from rns_viz.viz.server.app import RnsApp, serve_until_interrupted
 from rns_viz.viz.server.page_pacing import LateGate, gate_buffer
 from rns_viz.viz.server.presenter import WatchedSession, add_show_switch, add_watching_line, is_loopback, refuser
 from rns_viz.viz.server.visitor import CLOSED_TEXT, FULL_TEXT, Visitor
 
-# Simulations that keep real time (benchmarks/bench_visitors.py: TREP with its shadow run costs 27-36 % of a
-# core per visitor; 2 kept real time on 2 quiet cores, 3 did not): one per core, and no more than one
-# interpreter runs, however many cores (every visitor's threads share its lock)
-VISITORS_PER_CORE = 1
+# Simulations that keep real time with every page sent the scene at >= 30 Hz (benchmarks/bench_visitors.py,
+# TREP with its shadow run, 2 quiet cores): with the Python step 31 % of a core per visitor, 2 kept it and 3
+# did not; with the native step 20 %, 5 kept it. No more than one interpreter runs, however many cores
+# (every visitor's threads share its lock): hence a cap per process too.
+VISITORS_PER_CORE = 1.0  # (visitors per core, visitors per process) with the Python step
 VISITORS_PER_PROCESS = 3
+VISITORS_PER_CORE_NATIVE = 2.5  # ... and with the native step
+VISITORS_PER_PROCESS_NATIVE = 5
 IDLE_PAUSE_S = 5 * 60.0  # wall s without input before a visitor's simulation is paused
 IDLE_CLOSE_S = 20 * 60.0  # wall s without input before it is closed and its place freed
 IDLE_CHECK_S = 5.0  # wall s between looks for idle visitors
@@ -53,10 +57,14 @@ INPUT_MESSAGES: tuple[type, ...] = tuple(
 )
 
 
-def default_visitor_cap(cores: int | None = None) -> int:
-    """How many simulations this machine runs at once in real time: VISITORS_PER_CORE per core, at most
-    VISITORS_PER_PROCESS."""
-    return max(1, min(VISITORS_PER_PROCESS, VISITORS_PER_CORE * (cores or os.cpu_count() or 1)))
+def default_visitor_cap(cores: int | None = None, native: bool | None = None) -> int:
+    """How many simulations this machine runs at once in real time: so many per core, at most so many per
+    process, more with the native step (``native`` None: whether it is installed)."""
+    native = native_step.available() if native is None else native
+    per_core, most = (
+        (VISITORS_PER_CORE_NATIVE, VISITORS_PER_PROCESS_NATIVE) if native else (VISITORS_PER_CORE, VISITORS_PER_PROCESS)
+    )
+    return max(1, min(most, int(per_core * (cores or os.cpu_count() or 1))))
 
 
 class Classroom:
