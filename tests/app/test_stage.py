@@ -18,7 +18,7 @@ from rns_viz.param_file import Overlay
 from rns_viz.params import MODEL_NAMES, missing_extra
 from rns_viz.viz.panels.glossary import KEYS
 from rns_viz.viz.panels.keys import jog_step
-from rns_viz.viz.scene.framing import frame_points
+from rns_viz.viz.scene.framing import frame_points, is_narrow
 from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, FsmsScene
 from rns_viz.viz.scene.view_toggles import TOGGLES, first_look
 from rns_viz.viz.server.app import RnsApp, start_app
@@ -255,7 +255,7 @@ def test_a_page_is_framed_again_for_a_new_size_unless_its_view_was_moved(trep_ap
     scene, wxyz = trep_app.scene, (1.0, 0.0, 0.0, 0.0)
 
     def framed(size: tuple[int, int]) -> np.ndarray:  # where the app puts a camera of fov 1 rad for this canvas
-        return scene.camera_pose(1.0, size[0] / size[1], size[0]).position
+        return scene.camera_pose(1.0, size[0] / size[1], is_narrow(*size)).position
 
     with ProtocolClient(trep_app.port) as ws:
         wait_for_clients(trep_app, 1, "the page")

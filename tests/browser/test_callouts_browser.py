@@ -19,7 +19,7 @@ import viser
 from PIL import Image
 
 from rns_viz.viz.server.app import RnsApp, start_app
-from tests.browser.test_stage_browser import at_rest, canvas_box, reported_size, shown_size
+from tests.browser.test_stage_browser import at_rest, canvas_box, reported_size, reports, shown_size
 from tests.support.browser import (
     browser_page,
     dismiss_notifications,
@@ -108,7 +108,7 @@ def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
                 page.set_viewport_size({"width": w, "height": h})
                 wait_until(lambda w=w: shown_size(page)[0] <= w, 10.0, f"the canvas laid out at {w}x{h}")
                 try:
-                    wait_until(lambda: reported_size(client) == shown_size(page), 20.0, f"the page's size at {w}x{h}")
+                    wait_until(lambda: reports(client, page), 20.0, f"the page's size at {w}x{h}")
                 except AssertionError as e:
                     raise AssertionError(f"{e}: reported {reported_size(client)}, shown {shown_size(page)}") from e
                 app.frame_robot(client)

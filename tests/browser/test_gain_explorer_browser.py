@@ -19,6 +19,7 @@ from rns_viz.analysis import GainMap
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.viz.panels.gain_panel import QUANTITIES
 from rns_viz.viz.scene.framing import main_panel_box
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, RESIZE_PX
 from rns_viz.viz.scene.gain_scene import (
     MISSING_RGB,
     UNSTABLE_HATCH,
@@ -190,13 +191,25 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     client = next(iter(app.server.get_clients().values()))
     cam = client.camera
     wait_until(lambda: cam.update_timestamp > 0 and cam.image_width > 0, 10.0, "the page's camera")
+
+    def settled() -> bool:  # the app framed the page for the size it reports, long enough ago that a size it
+        # reports now (the docked panels take their widths over the first seconds) no longer frames it again
+        framed = app.scene.framed_pages.get(client.client_id)
+        size = (int(cam.image_width), int(cam.image_height))
+        if framed is None:
+            return False
+        (fw, fh), _, when = framed
+        near = abs(fw - size[0]) <= RESIZE_PX and abs(fh - size[1]) <= RESIZE_PX
+        return near and time.monotonic() - when > REFRAME_SETTLE_S
+
+    wait_until(settled, 30.0, "the page's own framing settled")
     # the scene's own canvas as laid out now, between the docked panels (the camera's size may predate them)
     width, height = page.evaluate(
         "() => { const c = [...document.querySelectorAll('canvas')].sort((a, b) =>"
         " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
         " return [c.clientWidth, c.clientHeight]; }"
     )
-    panel = main_panel_box(width)
+    panel = main_panel_box(width, height)
     below = panel[3] if panel is not None else 0.0  # px: the rows above are partly under the main panel
     free = height - below
     focal = 0.5 * height / math.tan(0.5 * cam.fov)  # px per unit of (offset / distance)
@@ -257,6 +270,8 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     marks = [scene.now, *scene._ticks, *scene._paper]  # (what covers cells)
     for mark in marks:
         mark.visible = False  # type: ignore[attr-defined]
+    labels_were = app.view.on("labels")  # the scene's callouts may stand over the map too
+    app.view.show("labels", False)
     # The page loads a new map's PNG into a texture in its own time (seconds on a busy machine): read
     # until the drawing agrees or PICTURE_WAIT_S has passed; a wrong picture never agrees.
     centre = screen_point(page, (0.0, 0.0, 0.0))
@@ -279,6 +294,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
             break
     for mark in marks:
         mark.visible = True  # type: ignore[attr-defined]
+    app.view.show("labels", labels_were)
     if not (read.sum() > 0.2 * read.size and agree[read].mean() >= AGREEING_CELLS):
         screenshot(page, f"gain_map_disagrees_{app.model_name}_{quantity}")
     bad = tuple(np.argwhere(read & ~agree)[0]) if not agree[read].all() else None

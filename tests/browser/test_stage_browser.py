@@ -14,7 +14,7 @@ import time
 import numpy as np
 import pytest
 
-from rns_viz.viz.scene.framing import NARROW_PX
+from rns_viz.viz.scene.framing import is_narrow
 from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, RESIZE_PX
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
@@ -105,8 +105,15 @@ def shown_size(page) -> tuple[int, int]:  # type: ignore[no-untyped-def]
 
 
 def reported_size(client) -> tuple[int, int]:  # type: ignore[no-untyped-def]
-    """The canvas size the page's last camera message told the server."""
+    """The canvas size the page's last camera message told the server (its drawing px)."""
     return int(client.camera.image_width), int(client.camera.image_height)
+
+
+def reports(client, page) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the server has the canvas as laid out now: its CSS size times the drawing density, which viser
+    lowers (to 3/4 at least) while a page draws slowly."""
+    (rw, rh), (sw, sh) = reported_size(client), shown_size(page)
+    return 0.74 * sw <= rw <= sw + 1 and 0.74 * sh <= rh <= sh + 1 and abs(rw * sh - rh * sw) <= 2 * max(sw, sh)
 
 
 def arm_on_screen(page, names: list[str], app: RnsApp) -> tuple[bool, float]:
@@ -142,12 +149,12 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                 page.set_viewport_size({"width": w, "height": h})
                 wait_until(lambda w=w: shown_size(page)[0] <= w, 10.0, f"the canvas laid out at {w}x{h}")
                 # the server frames for the canvas size the page last reported: wait until that is the new canvas
-                wait_until(lambda: reported_size(client) == shown_size(page), 10.0, f"the page's size at {w}x{h}")
+                wait_until(lambda: reports(client, page), 10.0, f"the page's size at {w}x{h}")
                 app.frame_robot(client)  # a page opened at this size is framed on its first camera message
                 # the page takes the new camera a frame or more later (slower on a busy machine) and echoes it:
                 # read the view once the page's camera is the one the framing set
                 cw, ch = reported_size(client)
-                want = app.scene.camera_pose(client.camera.fov, cw / ch, cw).position
+                want = app.scene.camera_pose(client.camera.fov, cw / ch, is_narrow(cw, ch)).position
                 taken = lambda want=want: np.allclose(client.camera.position, want, atol=1e-4)  # noqa: E731
                 wait_until(taken, 15.0, f"the framing at {w}x{h}")
                 # ... and once the page's camera has come to rest there (it may glide to a new pose)
@@ -155,7 +162,7 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                     wait_until(lambda: at_rest(page, joints, app), 15.0, f"the view at rest at {w}x{h}")
                 inside, span = arm_on_screen(page, joints, app)
                 print(f"\n{model} {w}x{h}: arm spans {span:.3f} of the view", end="")
-                least = PHONE_MIN_SPAN.get(model, MIN_SPAN) if w < NARROW_PX else MIN_SPAN
+                least = PHONE_MIN_SPAN.get(model, MIN_SPAN) if is_narrow(w, h) else MIN_SPAN
                 assert inside and span >= least, (w, h, span)
                 if w >= 1366:  # the base-deflection chart: in the viewport, no scrolling
                     chart = page.get_by_text("Base vibration x_b").first
@@ -177,18 +184,25 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
                 before = shown_size(page)
                 time.sleep(0.5)
                 now = shown_size(page)
-                return now == before and now[0] != 390 and reported_size(client) == now
+                return now == before and now[0] != 390 and reports(client, page)
 
             try:
-                wait_until(laid_out, 20.0, "the page laid out at 1366x768")
-            except AssertionError as e:
-                raise AssertionError(f"{e}: canvas {shown_size(page)}, reported {reported_size(client)}") from e
+                wait_until(laid_out, 10.0, "the page laid out at 1366x768")
+            except AssertionError:
+                # A page drawing in software may report its last size only with its next camera message (seen:
+                # the canvas 614x768, the server still told 537x672 after 20 s): a framing makes it send one
+                print(f"\n{model}: canvas {shown_size(page)}, reported {reported_size(client)}: framed", end="")
+                app.frame_robot(client)
+                try:
+                    wait_until(laid_out, 10.0, "the page laid out at 1366x768")
+                except AssertionError as e:
+                    raise AssertionError(f"{e}: canvas {shown_size(page)}, reported {reported_size(client)}") from e
 
             def framed_for_now() -> bool:  # the app's last framing of this page is for (about) its size now
                 (fw, fh), position, _ = app.scene.framed_pages[client.client_id]
                 cw, ch = reported_size(client)
                 near = abs(fw - cw) <= RESIZE_PX and abs(fh - ch) <= RESIZE_PX
-                return near and fw > NARROW_PX and np.allclose(client.camera.position, position, atol=1e-4)
+                return near and not is_narrow(fw, fh) and np.allclose(client.camera.position, position, atol=1e-4)
 
             wait_until(framed_for_now, 15.0, "the page framed again")
             time.sleep(REFRAME_SETTLE_S)  # the page settled: a size it reports now no longer re-frames it

@@ -1,7 +1,7 @@
 """The app's panels: every GUI element, built once by :func:`make_gui`.
 
-Three places (see the comment in :func:`make_gui`): the status line and *Live plots* docked left;
-*Controls* docked right (lessons, *Operate*, *Paper presets*, *Readouts*, *Reactionless path* or
+Three places (see the comment in :func:`make_gui`): *Live plots* docked left; *Controls* docked right
+(the status line, lessons, *Operate*, *Paper presets*, *Readouts*, *Reactionless path* or
 *Target*, *Control law and gains*, *Model and view*, the rest), with a *Help* tab; viser's main panel,
 small and floating, with *Frame robot* (and each page's operator seat). Labels carry units; hints
 explain the symbols. Model-specific elements are shown or hidden by the app, and their words set per
@@ -148,8 +148,8 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     menu = menu or ModelMenu((model,))
     gui = server.gui
     gui.configure_theme(control_width="large", show_logo=False, dark_mode=False)
-    # Three places. The status line and the live plots dock left, in view beside the robot whatever the
-    # controls are scrolled to; the controls dock right in a panel of their own; viser's main panel keeps only
+    # Three places. The live plots dock left, in view beside the robot whatever the controls are scrolled
+    # to; the status line and the controls dock right in a panel of their own; viser's main panel keeps only
     # Frame robot and who operates (a page's own), floating small in the scene's top right corner (callouts
     # keep off it). On a phone viser shows the main panel as a sheet over the page, opened: it is short this
     # way, and the two panels are sections under it (the plots opened, so a watcher sees the base plot; the
@@ -165,7 +165,6 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
     controls_panel.set_width(CONTROLS_WIDTH_PX)
     plots_panel = gui.add_panel(order=0.0)
     with plots_panel.add_tab("Live plots (last 10 s)", viser.Icon.CHART_LINE):
-        status = gui.add_html("")
         plots = LivePlots(gui)
     plots_panel.dock_left()
     plots_panel.set_width(PLOTS_WIDTH_PX)
@@ -176,6 +175,7 @@ def make_gui(server: viser.ViserServer, model: str, menu: ModelMenu | None = Non
         hint="Your camera back on the robot, framed for your screen (key F). Moves only your own view.",
     )
     with controls_tab:
+        status = gui.add_html("")  # first in the controls (on a phone: closed, the base plot higher up)
         elements = _controls(gui, model, menu)
     return GuiElements(
         status=status,

@@ -44,9 +44,9 @@ def page_camera(client: viser.ClientHandle) -> PageCamera | None:
         return None
     rotation = vtf.SO3(np.asarray(cam.wxyz, dtype=float)).as_matrix()
     position, width, height = np.asarray(cam.position, dtype=float), cam.image_width, cam.image_height
-    bottom, top = band_for(width)  # NDC y: a phone's panel sheet covers the page below the band
+    bottom, top = band_for(width, height)  # NDC y: a phone's panel sheet covers the page below the band
     shown = ((1.0 - top) / 2.0 * height, (1.0 - bottom) / 2.0 * height)
-    return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width))
+    return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width, height))
 
 
 @dataclass(eq=False)  # one callout is itself only (``in`` must not compare its arrays)

@@ -20,11 +20,12 @@ from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 
 FILL = 0.72  # the framed box spans at most this fraction of the view's width or height
-# px: a scene this narrow is a phone's page, which viser (below 576 px of page) covers with its panels' sheet
-# from below. The server learns the scene's width only, and on a desktop page the docked panels take
-# 744 px of it: this bound counts a 1280 px desktop page (536 px of scene) as wide, a phone held upright
-# (at most ~430 px) as narrow.
-NARROW_PX = 500
+# A scene narrower than this, width over height, is a phone's page held upright, which viser covers with its
+# panels' sheet from below. The server learns the scene's size only in the page's drawing pixels (CSS pixels
+# times the screen's density, which viser also lowers while a page draws slowly), so the rule is a shape:
+# a phone's scene is 0.45-0.6 (390x844 CSS px: 0.46), a desktop's between the docked panels 0.67 (1280x800)
+# and wider.
+NARROW_ASPECT = 0.62
 NARROW_BAND = (0.2, 0.95)  # NDC y band (bottom, top) the robot is fitted into on a narrow page (sheet below)
 # px: viser's main panel floats in the scene's top right corner on a wide page, (x, y, width) as
 # ``main_panel.float`` takes them (negative x: from the right edge), and about this tall (Frame robot and
@@ -94,15 +95,20 @@ def frame_points(
     return CameraPose(position=look_at + distance * d, look_at=look_at)
 
 
-def band_for(width_px: int) -> tuple[float, float]:
-    """The vertical band of the view the robot is fitted into on a page ``width_px`` wide."""
-    return NARROW_BAND if 0 < width_px < NARROW_PX else (-1.0, 1.0)
+def is_narrow(width: float, height: float) -> bool:
+    """Whether a scene of this size (the page's drawing px) is a phone's, with viser's sheet over its lower part."""
+    return width > 0 and height > 0 and width / height < NARROW_ASPECT
 
 
-def main_panel_box(width: int) -> tuple[float, float, float, float] | None:
-    """The floating main panel's box (x0, y0, x1, y1) on a page ``width`` px wide, in the canvas's px;
-    None on a narrow page (a sheet there, below the band of :func:`band_for`)."""
-    if width < NARROW_PX:
+def band_for(width: float, height: float) -> tuple[float, float]:
+    """The vertical band of the view the robot is fitted into on a scene of this size."""
+    return NARROW_BAND if is_narrow(width, height) else (-1.0, 1.0)
+
+
+def main_panel_box(width: float, height: float) -> tuple[float, float, float, float] | None:
+    """The floating main panel's box (x0, y0, x1, y1) on a scene of this size, in its px (taken as CSS px:
+    a dense screen's is smaller); None on a phone's (a sheet there, below the band of :func:`band_for`)."""
+    if is_narrow(width, height):
         return None
     x, y, panel_width = MAIN_PANEL_PX
     right = width + x if x < 0 else x + panel_width

@@ -25,11 +25,11 @@ from rns_viz.viz.scene.callouts import Callout, Callouts
 from rns_viz.viz.scene.framing import (
     DEFAULT_ASPECT,
     DEFAULT_FOV,
-    NARROW_PX,
+    NARROW_BAND,
     CameraPose,
-    band_for,
     frame_points,
     framed_points,
+    is_narrow,
 )
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
@@ -270,12 +270,12 @@ class FsmsScene:
             for client in self.server.get_clients().values():
                 self.frame_client(client)
 
-    def camera_pose(self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, width_px: int = 0) -> CameraPose:
+    def camera_pose(self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, narrow: bool = False) -> CameraPose:
         """Where a camera of this field of view and aspect sees the robot framed (framing.py), with the
-        points of :meth:`frame_also`."""
+        points of :meth:`frame_also`; ``narrow``: a phone's page (the robot above viser's sheet)."""
         direction = np.subtract(self.style.camera_position, self.style.camera_look_at)
         points = self.framed if self.also_framed is None else np.vstack([self.framed, self.also_framed])
-        return frame_points(points, direction, fov, aspect, band=band_for(width_px))
+        return frame_points(points, direction, fov, aspect, band=NARROW_BAND if narrow else (-1.0, 1.0))
 
     def frame_also(self, points: np.ndarray | None) -> None:
         """Frame the world ``points`` (N, 3), m, with the robot from now on (None: the robot alone), and
@@ -288,7 +288,7 @@ class FsmsScene:
         cam = client.camera
         width, height = cam.image_width, cam.image_height
         aspect = width / height if width > 0 and height > 0 else DEFAULT_ASPECT
-        pose = self.camera_pose(cam.fov, aspect, width)
+        pose = self.camera_pose(cam.fov, aspect, is_narrow(width, height))
         with client.atomic():
             cam.up_direction = (0.0, 0.0, 1.0)
             cam.position = pose.position  # (viser moves look_at with the position: it is set after)
@@ -316,7 +316,7 @@ class FsmsScene:
         (w0, h0), position, when = last
         if abs(width - w0) <= RESIZE_PX and abs(height - h0) <= RESIZE_PX:  # the same page, to rounding
             return
-        turned = (0 < w0 < NARROW_PX) != (width < NARROW_PX)
+        turned = is_narrow(w0, h0) != is_narrow(width, height)
         distance = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
         untouched = bool(np.allclose(cam.position, position, atol=1e-4 * max(distance, 1e-3)))
         if turned or untouched or time.monotonic() - when < REFRAME_SETTLE_S:

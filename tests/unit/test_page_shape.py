@@ -1,0 +1,26 @@
+"""Which pages count as a phone's: the server sees a page's scene in drawing pixels (CSS px times the
+screen's density, lowered by viser while a page draws slowly), so the rule must give the same answer for
+a page at any density."""
+
+from __future__ import annotations
+
+import pytest
+
+from rns_viz.viz.scene.framing import NARROW_BAND, band_for, is_narrow, main_panel_box
+
+PHONES = [(390, 844), (430, 932), (412, 785), (360, 800), (390, 664)]  # CSS px, upright, toolbars or not
+DESKTOPS = [(536, 800), (622, 768), (696, 900), (1176, 1080)]  # the scene between the docked panels
+
+
+@pytest.mark.parametrize("density", [1.0, 0.875, 2.0, 3.0])
+def test_a_phone_is_narrow_and_a_desktop_wide_at_any_density(density: float) -> None:
+    for w, h in PHONES:
+        size = (w * density, h * density)
+        assert is_narrow(*size) and band_for(*size) == NARROW_BAND and main_panel_box(*size) is None, size
+    for w, h in DESKTOPS:
+        size = (w * density, h * density)
+        assert not is_narrow(*size) and band_for(*size) == (-1.0, 1.0) and main_panel_box(*size) is not None, size
+
+
+def test_no_size_yet_is_not_narrow() -> None:
+    assert not is_narrow(0, 0) and not is_narrow(390, 0)
