@@ -169,15 +169,18 @@ class NumberField:
                 waiting = self._timers.pop(client.client_id, None)
                 if waiting is not None:
                     waiting.cancel()
-                pause = UNFINISHED_PAUSE_S if is_unfinished_number(str(event.target.value)) else TYPING_PAUSE_S
-                timer = threading.Timer(pause, self._paused, (client, typed))
+                text = str(event.target.value)  # now: the server may write the box before the pause ends
+                pause = UNFINISHED_PAUSE_S if is_unfinished_number(text) else TYPING_PAUSE_S
+                timer = threading.Timer(pause, self._paused, (client, typed, text))
                 timer.daemon = True
                 self._timers[client.client_id] = timer
                 timer.start()
 
         self.box.on_update(keystroke)
 
-    def _paused(self, client: viser.ClientHandle, typed: Typed) -> None:
+    def _paused(self, client: viser.ClientHandle, typed: Typed, text: str) -> None:
         with self._lock:
-            self._timers.pop(client.client_id, None)
-        typed(client, self.box.value)
+            if self._timers.get(client.client_id) is not threading.current_thread():
+                return  # a later keystroke of this client started its own pause
+            del self._timers[client.client_id]
+        typed(client, text)
