@@ -221,7 +221,26 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     shift = -0.5 * below / focal * distance * up  # the map's centre half the panel's rows down the page
     cam.position = scene.centre + distance * scene.rotation[:, 2] - shift
     cam.look_at = scene.centre - shift
+    FACED[client.client_id] = np.array(cam.position, dtype=float)
     wait_for_frames(page, 10)
+
+
+FACED: dict[int, np.ndarray] = {}  # client id -> where face_the_map put its camera (m)
+
+
+def face_again_if_framed(app: RnsApp, page: Page, scene: GainScene) -> None:
+    """Face the map again if the app framed the page since (seen in CI on a busy machine: a framing landed
+    after the map was faced, and the cells were 1.6 px apart); says so, with the page's last framing."""
+    client = next(iter(app.server.get_clients().values()))
+    faced = FACED.get(client.client_id)
+    if faced is None:
+        return
+    here = np.asarray(client.camera.position, dtype=float)
+    if np.allclose(here, faced, atol=1e-4 * max(float(np.linalg.norm(faced - scene.centre)), 1e-3)):
+        return
+    (fw, fh), _, when = app.scene.framed_pages[client.client_id]
+    print(f"\n{app.model_name}: framed {time.monotonic() - when:.1f} s ago for {fw}x{fh}: map faced again", end="")
+    face_the_map(app, page, scene)
 
 
 def screen_cells(page: Page, scene: GainScene, gm: GainMap) -> np.ndarray:
@@ -279,11 +298,14 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     page.mouse.move(*(centre if hovered else (5.0, 5.0)))
     deadline = time.monotonic() + PICTURE_WAIT_S
     while True:
+        face_again_if_framed(app, page, scene)
         dismiss_notifications(page)  # a toast arriving late (a busy machine) sits over part of the map
         wait_for_frames(page, 10)
         gm, scale = scene.gain_map, legend_scale(scene.legend.text)  # (the map of the pose now)
         cells = screen_cells(page, scene, gm)  # (where the page's camera is now)
         spacing = np.linalg.norm(cells[1, 0] - cells[0, 0])
+        if spacing < 6.0 and time.monotonic() < deadline:
+            continue  # the view changed under the test (framed again): faced again at the top
         assert spacing >= 6.0, f"cells {spacing:.1f} px apart: too small to read one pixel block each"
         drawn = read_pixels(page, cells)
         rates = map_rates(gm, quantity)  # type: ignore[arg-type]
