@@ -158,6 +158,24 @@ def check_first_look_and_toggles(app: RnsApp, model: str) -> None:
     wait_until(lambda: not explorer.scene.frame.visible, 5.0, "the map hidden again")
 
 
+def test_labels_keep_off_the_gain_map_while_it_is_shown(trep_app: RnsApp) -> None:
+    """The map, its title, ticks and legend are one solid of the callouts' layout while shown (no label
+    covers a cell of it; the layout keeps labels off every solid: tests/unit/test_callouts.py), none hidden."""
+    app, callouts = trep_app, trep_app.renderer.callouts
+    explorer = app.renderer.explorer
+    wait_until(lambda: explorer.scene is not None and explorer.scene.gain_map is not None, 60.0, "the map")
+    assert explorer.scene is not None
+    arm = callouts.solids()
+    app.view.show("gain_map")
+    wait_until(lambda: app.scene.also_framed is not None, 5.0, "the map framed beside the robot")
+    with_map = callouts.solids()
+    assert len(with_map) == len(arm) + 1
+    assert {tuple(p) for p in with_map[-1]} == {tuple(p) for p in explorer.scene.framed_corners()}
+    app.view.show("gain_map", False)
+    wait_until(lambda: app.scene.also_framed is None, 5.0, "the map hidden")
+    assert len(callouts.solids()) == len(arm)
+
+
 def test_other_paths_toggle_draws_the_family_or_only_the_current_path(trep_app: RnsApp) -> None:
     app = trep_app
     paths = app.server.scene.get_handle_by_name(FsmsScene.PATHS)

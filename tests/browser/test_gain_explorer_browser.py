@@ -304,7 +304,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     marks = [scene.now, *scene._ticks, *scene._paper]  # (what covers cells)
     for mark in marks:
         mark.visible = False  # type: ignore[attr-defined]
-    labels_were = app.view.on("labels")  # the scene's callouts may stand over the map too
+    labels_were = app.view.on("labels")  # callouts keep off the map, but their layout lags the view set here
     app.view.show("labels", False)
     # The page loads a new map's PNG into a texture in its own time (seconds on a busy machine): read
     # until the drawing agrees or PICTURE_WAIT_S has passed; a wrong picture never agrees.

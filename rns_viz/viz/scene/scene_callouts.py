@@ -63,8 +63,13 @@ class SceneCallouts:
         return [cam for cam in cameras if cam is not None]
 
     def solids(self) -> np.ndarray:
-        """World corners of every visual box of the robot's arm, and of the ghost's when it is shown."""
+        """World corners (L, 8, 3) of every visual box of the robot's arm, of the ghost's when it is shown, and
+        of what the view frames beside the robot (the gain map with its title, ticks and legend, while shown):
+        no label covers a cell of the map."""
         parts = [self.scene.robot.link_corners()]
         if self.ghost.root.visible:
             parts.append(self.ghost.robot.link_corners())
+        beside, corners = self.scene.also_framed, parts[0].shape[1]
+        if beside is not None and len(beside) and corners:  # one solid: its corners repeated to a link's count
+            parts.append(np.resize(beside, (1, corners, 3)))
         return np.concatenate(parts)
