@@ -132,3 +132,17 @@ def test_the_readout_names_it_in_words_first(app: RnsApp) -> None:
 
     html = readouts_html(app.session.snapshot())
     assert "distance to singularity σ<sub>min</sub>(W S H<sub>bm</sub>)" in html
+
+
+def test_the_status_line_says_a_slow_rate_and_a_skip_apart(app: RnsApp) -> None:
+    """After a stall the rate may be back at (or over) the speed while the skipped time is still said: the
+    line never shows "falling behind" beside a rate at the speed."""
+    from rns_viz.viz.panels.panel_text import status_html
+
+    snap = replace(app.session.snapshot(), paused=False, diverged=None)
+    caught_up = status_html(replace(snap, rtf=1.14, behind=False, skipped=0.31))
+    assert "SKIPPED 0.31 s" in caught_up and "FALLING BEHIND" not in caught_up and "1.14× real time" in caught_up
+    slow = status_html(replace(snap, rtf=0.7, behind=True, skipped=0.0))
+    assert "FALLING BEHIND" in slow and "SKIPPED" not in slow
+    steady = status_html(replace(snap, rtf=1.0, behind=False, skipped=0.0))
+    assert "FALLING BEHIND" not in steady and "SKIPPED" not in steady

@@ -9,7 +9,7 @@ from collections.abc import Iterator
 import pytest
 
 from rns_viz.live.loop import wall_clock as pacing
-from rns_viz.live.loop.wall_clock import BEHIND_HOLD_S, RTF_WINDOW_S, SPEEDS, Pacer
+from rns_viz.live.loop.wall_clock import RTF_WINDOW_S, SKIPPED_HOLD_S, SPEEDS, Pacer
 
 
 class Clock:
@@ -66,15 +66,26 @@ def test_only_the_offered_speeds_are_accepted(clock: Clock) -> None:
     assert p.speed == 1.0
 
 
-def test_a_dropped_backlog_is_counted_re_anchored_and_flagged_for_a_while(clock: Clock) -> None:
+def test_a_dropped_backlog_is_counted_re_anchored_and_said_for_a_while(clock: Clock) -> None:
     p = Pacer(1.0)
     clock.now += 0.8  # a stall
     assert p.backlog(0.3, clock.now) == pytest.approx(0.5)
     p.drop_backlog(0.3)
     assert p.dropped == 1 and p.backlog(0.3, clock.now) == 0.0
-    assert p.behind()
-    clock.now += BEHIND_HOLD_S + 0.01
-    assert not p.behind()  # the flag came down (and no rate measured to raise it)
+    assert p.skipped() == pytest.approx(0.5)  # simulated s given up
+    assert not p.behind()  # no rate measured under the speed: the skip is said, not a slow rate
+    clock.now += 0.5
+    p.drop_backlog(0.7)  # another stall soon after: 0.8 s due, 0.7 run, 0.1 s more given up (summed)
+    assert p.skipped() == pytest.approx(0.6)
+    clock.now += SKIPPED_HOLD_S + 0.01
+    assert p.skipped() == 0.0
+
+
+def test_at_half_speed_a_skip_is_in_simulated_seconds(clock: Clock) -> None:
+    p = Pacer(0.5)
+    clock.now += 1.0  # 0.5 simulated s due
+    p.drop_backlog(0.1)
+    assert p.skipped() == pytest.approx(0.4)
 
 
 def test_real_time_factor_over_the_last_window(clock: Clock) -> None:

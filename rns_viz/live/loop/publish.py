@@ -16,15 +16,16 @@ def make_snapshot(
     runs: RunPair,
     op: Operator | None,
     out: Outputs,
-    flags: tuple[bool, str | None, float, bool],
+    flags: tuple[bool, str | None, float, bool, float],
     lesson: LessonStatus | None,
     replay: ReplayView | None = None,
 ) -> Snapshot:
     """The loop's state for readers, a new immutable record each time. ``versions`` = (epoch, settings,
-    target, overlay) versions; ``flags`` = (paused, why it diverged or None, real-time factor, behind)."""
+    target, overlay) versions; ``flags`` = (paused, why it diverged or None, real-time factor, behind,
+    simulated s skipped lately)."""
     sim = runs.sim
     epoch, settings_version, target_version, overlay_version = versions
-    paused, diverged, rtf, behind = flags
+    paused, diverged, rtf, behind, skipped = flags
     table = op.table if op is not None else None
     mode, target = (op.mode, op.target) if op is not None else (f"preset {settings.preset}", None)
     readouts = replace(
@@ -43,6 +44,7 @@ def make_snapshot(
         diverged=diverged,
         rtf=rtf,
         behind=behind,
+        skipped=skipped,
         mode="paused" if paused and not diverged else mode,
         target=None if target is None else target.copy(),
         target_version=target_version,

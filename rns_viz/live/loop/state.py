@@ -395,6 +395,6 @@ class LiveState:
         versions = (self.epoch, self.settings_version, self.target_version, self.geometry.version)
         lesson = self.lesson.status() if self.lesson is not None else None
         rtf = 0.0 if self.paused else self.pacer.rtf() if realtime else math.nan
-        flags = (self.paused, self.diverged, rtf, realtime and not self.paused and self.pacer.behind())
+        flags = (self.paused, self.diverged, rtf, *self.pacer.lateness(realtime and not self.paused))
         out = (self.runs, self.operator, self.outputs)
         return make_snapshot(self.settings, versions, *out, flags, lesson, self.replay)

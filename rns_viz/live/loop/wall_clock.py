@@ -1,4 +1,4 @@
-"""Wall-clock pacing of the simulation loop, the real-time factor and the falling-behind flag."""
+"""Wall-clock pacing of the simulation loop, the real-time factor, the falling-behind flag and the time skipped."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0)  # simulated seconds per wall-clock second
 MAX_BACKLOG_S = 0.25  # wall s: a shorter stall (another process took the CPU) is caught up, a longer one
 # dropped and flagged: catching up runs the simulation faster than real time for a moment
 RTF_WINDOW_S = 1.0  # wall s over which the real-time factor is measured
-BEHIND_HOLD_S = 2.0  # wall s the falling-behind flag stays up after a dropped backlog
+SKIPPED_HOLD_S = 2.0  # wall s a dropped backlog stays reported (the status line says what was skipped)
 
 
 class Pacer:
@@ -21,6 +21,7 @@ class Pacer:
         self.anchor_sim = 0.0
         self.dropped = 0  # how often a backlog was dropped
         self._last_drop = -1e9
+        self._skipped = 0.0  # simulated s dropped within SKIPPED_HOLD_S of the last drop
         self._samples: deque[tuple[float, float]] = deque()
 
     def reanchor(self, sim_t: float) -> None:
@@ -40,9 +41,13 @@ class Pacer:
         return (self.anchor_sim + (now - self.anchor_wall) * self.speed - sim_t) / self.speed
 
     def drop_backlog(self, sim_t: float) -> None:
+        """Give up the simulated time that is due and not yet run (a stall longer than MAX_BACKLOG_S)."""
+        now = time.perf_counter()
+        skipped = self.backlog(sim_t, now) * self.speed
+        self._skipped = skipped + (self._skipped if now - self._last_drop < SKIPPED_HOLD_S else 0.0)
         self.dropped += 1
-        self._last_drop = time.perf_counter()
-        self.anchor_wall = self._last_drop
+        self._last_drop = now
+        self.anchor_wall = now
         self.anchor_sim = sim_t
 
     def sample(self, sim_t: float, now: float) -> None:
@@ -59,8 +64,15 @@ class Pacer:
         return (s1 - s0) / (w1 - w0) if w1 - w0 > 0.2 else float("nan")
 
     def behind(self) -> bool:
-        """True while the loop cannot keep up with the chosen speed."""
-        if time.perf_counter() - self._last_drop < BEHIND_HOLD_S:
-            return True
+        """True while the measured rate is under the chosen speed (by more than 5 %): the loop cannot keep up."""
         r = self.rtf()
         return r == r and r < 0.95 * self.speed
+
+    def skipped(self) -> float:
+        """Simulated seconds given up by the drops of the last SKIPPED_HOLD_S (0 if none): after a stall the
+        rate may be at or above the speed again (catching up what is left), so this is said apart from it."""
+        return self._skipped if time.perf_counter() - self._last_drop < SKIPPED_HOLD_S else 0.0
+
+    def lateness(self, running: bool) -> tuple[bool, float]:
+        """(:meth:`behind`, :meth:`skipped`) of a loop that runs in real time now; (False, 0) otherwise."""
+        return (self.behind(), self.skipped()) if running else (False, 0.0)

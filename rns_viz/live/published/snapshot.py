@@ -132,7 +132,8 @@ class Snapshot:
     paused: bool
     diverged: str | None
     rtf: float
-    behind: bool
+    behind: bool  # the measured rate is under the chosen speed
+    skipped: float  # simulated s given up after stalls in the last 2 s (0: none)
     mode: str
     target: np.ndarray | None  # base frame, m: where the arm is going
     target_version: int  # bumps when the target marker or handle should jump there

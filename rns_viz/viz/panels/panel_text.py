@@ -35,7 +35,11 @@ def status_html(snap: Snapshot) -> str:
     else:
         state = _badge("RUNNING", OK_COLOUR)
     rtf = "–" if snap.paused or not math.isfinite(snap.rtf) else f"{snap.rtf:.2f}"
-    behind = " " + _badge("FALLING BEHIND", BAD_COLOUR) if snap.behind else ""
+    behind = ""  # the rate beside it says by how much; a skip after a stall is said apart (the rate may be back)
+    if snap.behind:
+        behind = " " + _badge("FALLING BEHIND", BAD_COLOUR)
+    elif snap.skipped > 0.0:
+        behind = " " + _badge(f"SKIPPED {snap.skipped:.2f} s", WARN_COLOUR)
     preset = f" · preset <b>{st.preset}</b>" if st.preset else ""
     flags = key_selection(st.model)
     if flags is not None:
