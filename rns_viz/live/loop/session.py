@@ -42,7 +42,11 @@ BURST_S = 0.003  # wall s: when ahead, the loop sleeps until this much simulatio
 
 
 class Session:
-    def __init__(self, model: str = "trep", realtime: bool = True, shadow: bool = True, speed: float = 1.0) -> None:
+    def __init__(
+        self, model: str = "trep", realtime: bool = True, shadow: bool = True, speed: float = 1.0, start: bool = True
+    ) -> None:
+        """``realtime``: a loop thread runs the simulation at wall-clock pace (else :meth:`advance` drives it);
+        ``start=False``: that thread waits for :meth:`start` (an app starts it once its pages can be served)."""
         check_model_key(model)  # a bad model file raises ModelFileError (a ValueError) when the state loads it
         if speed not in SPEEDS:
             raise ValueError(f"speed must be one of {SPEEDS}")
@@ -58,7 +62,14 @@ class Session:
         self._publish()
         self._thread: threading.Thread | None = None
         self._stop = False
-        if realtime:
+        if realtime and start:
+            self.start()
+
+    def start(self) -> None:
+        """Run the real-time loop from now: the time spent before (building an app around the session) is not
+        simulated time due, so the loop starts without a backlog to catch up or to skip."""
+        if self.realtime and self._thread is None and not self._stop:
+            self.pacer.reanchor(self.state.runs.t)
             self._thread = threading.Thread(target=self._run, name="rns-sim", daemon=True)
             self._thread.start()
 

@@ -232,7 +232,7 @@ def start_app(
     ``pace=False``: every page gets every update however slowly it draws (for comparisons; see
     :mod:`rns_viz.viz.server.page_pacing`); ``pause_unwatched``: see :class:`RnsApp`; ``present``:
     larger text and fewer folders, for a projector."""
-    session = Session(model, realtime=realtime)
+    session = Session(model, realtime=realtime, start=False)  # started once the app is built (no backlog)
     server = viser.ViserServer(host=host, port=port, verbose=verbose)
     server.gui.set_panel_label("rns_viz: reaction null-space control")
     try:
@@ -256,6 +256,7 @@ def start_app(
     # a full collection holds the interpreter lock, and with it the simulation, for far less time.
     gc.collect()
     gc.freeze()
+    session.start()
     return app
 
 

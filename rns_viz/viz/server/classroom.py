@@ -89,7 +89,7 @@ class Classroom:
         self.max_visitors = max_visitors or default_visitor_cap()
         self.idle_pause_s = idle_pause_s
         self.idle_close_s = idle_close_s
-        self.make_session = make_session or (lambda name: Session(name, realtime=True))
+        self.make_session = make_session or (lambda name: Session(name, realtime=True, start=False))
         self.is_presenter = is_presenter or (lambda cid: is_loopback(server, cid))
         self.showing: int | None = None  # the presenter whose simulation every page shows
         self.visitors: dict[int, Visitor] = {}
@@ -191,6 +191,7 @@ class Classroom:
         except Exception:
             self._close(visitor)
             raise
+        visitor.session.start()  # its clock from now: the page's app being built is no simulated time due
         with self._guard:
             gone = visitor.view.client.client_id not in self.visitors
         if gone:  # the page left while its app was built
