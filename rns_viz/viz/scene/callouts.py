@@ -111,11 +111,12 @@ class Callouts:
         if live and now >= self.next_layout:
             self.next_layout = now + LAYOUT_S
             cameras = pages()
-            corners = solids() if cameras else None
-            seen = self._seen(live, cameras, corners) if corners is not None else None
-            if seen is not None and corners is not None and not self._same(seen):
-                self._laid_out = seen
-                self._layout(live, cameras, corners)
+            if cameras:  # no page: the labels stay where they were
+                corners = solids()
+                seen = self._seen(live, cameras, corners)
+                if not self._same(seen):
+                    self._laid_out = seen
+                    self._layout(live, cameras, corners)
         for item in self.items.values():
             self._draw(item, item in live)
 
