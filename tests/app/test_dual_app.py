@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.panels.panel_text import BAD_COLOUR, OK_COLOUR, readouts_html
+from rns_viz.viz.scene.ghost import GHOST_OFF_COLOUR
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import wait_until
 from tests.support.logs import independent_reaction, log_row
@@ -39,6 +40,7 @@ def test_both_arms_are_drawn_and_the_ghost_holds_its_compensator(trep2_app: RnsA
     ghost = app.renderer.teach.ghost
     wait_until(lambda: ghost.q is not None and abs(ghost.q[0] - snap.q_shadow[0]) < 1e-4, 5.0, "the ghost")
     assert "cancelling" in readouts_html(snap) and OK_COLOUR in readouts_html(snap)
+    assert ghost.colour == GHOST_OFF_COLOUR  # the held compensator's run: red, as "compensator held still" plots
 
 
 def test_a_singular_compensator_is_shown_and_its_residual_reaction_drawn(trep2_app: RnsApp) -> None:

@@ -17,6 +17,29 @@ from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import wait_until
 
 
+def _nearest(colour: tuple[int, int, int], legend: dict[str, str]) -> str:
+    """The legend entry whose colour (#rrggbb) is nearest ``colour`` (RGB 0-255)."""
+    rgb = {name: np.array([int(c[i : i + 2], 16) for i in (1, 3, 5)]) for name, c in legend.items()}
+    return min(rgb, key=lambda name: float(np.linalg.norm(rgb[name] - np.array(colour))))
+
+
+def test_the_ghost_takes_its_runs_colour_in_the_plots(trep_app: RnsApp) -> None:
+    """Blue is suppression on and red off in every plot: the ghost, the shadow run, is drawn so, whichever way
+    the operated run's suppression is set (it had been blue always, also as the suppression-off run)."""
+    from rns_viz.viz.panels.live_plots import OFF_COLOUR, ON_COLOUR
+
+    app, s = trep_app, trep_app.session
+    ghost = app.renderer.teach.ghost
+    legend = {"on": ON_COLOUR, "off": OFF_COLOUR}
+    for suppress in (True, False, True):
+        s.set_suppression(suppress)
+        s.advance(0.05)
+        shadow = "off" if suppress else "on"
+        wait_until(lambda shadow=shadow: _nearest(ghost.colour, legend) == shadow, 5.0, f"a {shadow} ghost")
+        assert ghost.label_text == f"ghost: suppression {shadow}"
+        assert all(tuple(mesh.color) == ghost.colour for mesh in ghost.robot.meshes)
+
+
 def test_ghost_draws_the_shadow_run_not_the_operated_one(trep_app: RnsApp, trep: FsmsModel) -> None:
     app, s = trep_app, trep_app.session
     assert s.snapshot().settings.suppress

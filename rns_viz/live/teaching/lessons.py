@@ -260,7 +260,8 @@ TREP_LESSONS = (
         "Press *Kick the base* and compare the arm with its shadow.",
         LessonStart("trep", "velocity", True),
         SuppressedVersusShadow,
-        look="the arm against its blue ghost, and the blue line against the red one in the base vibration plot.",
+        look="the arm against its red ghost (suppression off), and the blue line against the red one in the base "
+        "vibration plot.",
     ),
     Lesson(
         "trep-weakest-point",

@@ -146,7 +146,7 @@ BOOM7_LESSONS = (
         "Eqs. (13), (15)",
         "boom7: a 7-joint arm on the tip of a 4 m boom. The tip has six elastic coordinates: three "
         "translations and three small rotations. Law (15) moves the arm so that every one of them is damped, "
-        "x_b'' + G_b x_b' + H_b⁻¹ K_b x_b = 0 (Eq. 13). The blue ghost is the shadow run, suppression off.",
+        "x_b'' + G_b x_b' + H_b⁻¹ K_b x_b = 0 (Eq. 13). The red ghost is the shadow run, suppression off.",
         "Kick the base (5 N or more, any direction in *Base coordinates*) and read the six deflections: the "
         "operated boom stops while the shadow rings. Untick *Vibration suppression* to see it the other way.",
         LessonStart("boom7", "acceleration", True),

@@ -350,7 +350,7 @@ def _controls(gui: viser.GuiApi, model: str, menu: ModelMenu) -> dict[str, Any]:
             "Ghost run (suppression the other way)",
             True,
             hint="The shadow run: a second simulation with the same inputs and kicks and suppression the other way: "
-            "the blue ghost and the second plot lines.",
+            "the ghost (blue: suppression on, red: off, as the plot lines) and the second plot lines.",
         )
     download = gui.add_button(
         "Download log (CSV)",

@@ -40,7 +40,8 @@ GLOSSARY: tuple[tuple[str, str, str, str], ...] = (
     (
         "ghost run (shadow run)",
         "—",
-        "a second simulation with the same pushes but suppression the other way: the blue ghost",
+        "a second simulation with the same pushes but suppression the other way: the ghost, blue or red as its "
+        "plot lines",
         "",
     ),
     ("drawn larger", "×", "the base's bend is drawn this many times larger than simulated (written beside it)", ""),

@@ -17,7 +17,9 @@ from rns_viz.viz.scene.boom_drawing import BoomDrawing
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.scene.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle
 
-GHOST_COLOUR = (90, 140, 235)  # pale blue, RGB 0-255
+# The plots' colours, paled (RGB 0-255): the ghost's run has suppression (or compensation) on, or off.
+GHOST_ON_COLOUR = (90, 140, 235)  # pale blue (the plots' blue #1f6fd1)
+GHOST_OFF_COLOUR = (235, 110, 90)  # pale red (the plots' red #e0503a)
 GHOST_OPACITY = 0.35
 
 
@@ -29,7 +31,7 @@ class GhostMeshes(RobotMeshes):
             name,
             np.asarray(mesh.vertices, dtype=np.float32),
             np.asarray(mesh.faces, dtype=np.uint32),
-            color=GHOST_COLOUR,
+            color=GHOST_OFF_COLOUR,  # the shadow of a run with suppression on, the default
             opacity=GHOST_OPACITY,
             cast_shadow=False,
             receive_shadow=False,
@@ -53,10 +55,12 @@ class Ghost:
         self.label_text = "ghost"  # what its callout says (drawn by the renderer's callouts, off the arm)
         self.q: np.ndarray | None = None  # the shadow's q as drawn (before exaggeration)
         self.exaggeration = float("nan")
+        self.colour = GHOST_OFF_COLOUR
         self.root.visible = False
 
-    def update(self, q: np.ndarray | None, exaggeration: float, label: str) -> None:
-        """Pose the ghost at the shadow's q = (x_b, theta) (base drawn x exaggeration); None hides it."""
+    def update(self, q: np.ndarray | None, exaggeration: float, label: str, on: bool = False) -> None:
+        """Pose the ghost at the shadow's q = (x_b, theta) (base drawn x exaggeration); None hides it. ``on``:
+        the shadow run has suppression (or compensation) on: drawn blue, else red, as its plot lines."""
         if q is None or not np.all(np.isfinite(q)):
             if self.root.visible:
                 self.root.visible = False
@@ -64,6 +68,7 @@ class Ghost:
         if not self.root.visible:
             self.root.visible = True
         self.label_text = label
+        self._paint(GHOST_ON_COLOUR if on else GHOST_OFF_COLOUR)
         if self.q is not None and np.array_equal(q, self.q) and exaggeration == self.exaggeration:
             return
         self.q, self.exaggeration = np.array(q, dtype=float), exaggeration
@@ -76,6 +81,15 @@ class Ghost:
             elif self.base_drawing is not None:
                 self.base_drawing.update(self.robot.base_placement().translation)
 
+    def _paint(self, colour: tuple[int, int, int]) -> None:
+        if colour == self.colour:
+            return
+        self.colour = colour
+        with self.server.atomic():
+            for mesh in self.robot.meshes:
+                mesh.color = colour  # type: ignore[attr-defined]
+            _paint_base(self.base_drawing, colour)
+
     def drawn_base_position(self) -> np.ndarray:
         """World position of the ghost's base node as last sent (m; exaggerated)."""
         return np.asarray(self.robot.base_node.position, dtype=float)
@@ -85,24 +99,36 @@ def _ghost_base(
     server: viser.ViserServer, model: FsmsModel, style: DoubleBeamStyle | CartSpringStyle | BoomStyle | None
 ) -> DoubleBeamDrawing | CartSpringDrawing | BoomDrawing | None:
     """The model's base drawing under /ghost, translucent, without its fixed parts (clamp, wall)."""
+    drawing: DoubleBeamDrawing | CartSpringDrawing | BoomDrawing
     if isinstance(style, BoomStyle):
-        boom = BoomDrawing(server, model, style, root="/ghost/boom")
-        boom.mesh.color, boom.mesh.opacity = GHOST_COLOUR, GHOST_OPACITY
-        boom.stripe.colors = _tinted(boom.stripe.points)
+        drawing = BoomDrawing(server, model, style, root="/ghost/boom")
         _hide(server, "/ghost/boom/clamp")
-        return boom
-    if isinstance(style, DoubleBeamStyle):
-        beam = DoubleBeamDrawing(server, model, style, root="/ghost/beam")
-        beam.mesh.color, beam.mesh.opacity = GHOST_COLOUR, GHOST_OPACITY
-        beam.edges.colors = _tinted(beam.edges.points)
+    elif isinstance(style, DoubleBeamStyle):
+        drawing = DoubleBeamDrawing(server, model, style, root="/ghost/beam")
         _hide(server, "/ghost/beam/clamp")
-        return beam
-    if isinstance(style, CartSpringStyle):
-        spring = CartSpringDrawing(server, model, style, root="/ghost/spring")
-        spring.spring.colors = _tinted(spring.spring.points)
+    elif isinstance(style, CartSpringStyle):
+        drawing = CartSpringDrawing(server, model, style, root="/ghost/spring")
         _hide(server, "/ghost/spring/wall")
-        return spring
-    return None
+    else:
+        return None
+    if not isinstance(drawing, CartSpringDrawing):
+        drawing.mesh.opacity = GHOST_OPACITY
+    _paint_base(drawing, GHOST_OFF_COLOUR)
+    return drawing
+
+
+def _paint_base(
+    drawing: DoubleBeamDrawing | CartSpringDrawing | BoomDrawing | None, colour: tuple[int, int, int]
+) -> None:
+    """The base drawing's surfaces and lines in ``colour``."""
+    if isinstance(drawing, BoomDrawing):
+        drawing.mesh.color = colour
+        drawing.stripe.colors = _tinted(drawing.stripe.points, colour)
+    elif isinstance(drawing, DoubleBeamDrawing):
+        drawing.mesh.color = colour
+        drawing.edges.colors = _tinted(drawing.edges.points, colour)
+    elif isinstance(drawing, CartSpringDrawing):
+        drawing.spring.colors = _tinted(drawing.spring.points, colour)
 
 
 def _hide(server: viser.ViserServer, name: str) -> None:
@@ -111,6 +137,6 @@ def _hide(server: viser.ViserServer, name: str) -> None:
         handle.visible = False
 
 
-def _tinted(points: np.ndarray) -> np.ndarray:
-    """Per-vertex colours of a line-segment node (N, 2, 3), all the ghost's colour."""
-    return np.tile(np.array(GHOST_COLOUR, dtype=np.uint8), (*np.shape(points)[:2], 1))
+def _tinted(points: np.ndarray, colour: tuple[int, int, int]) -> np.ndarray:
+    """Per-vertex colours of a line-segment node (N, 2, 3), all ``colour``."""
+    return np.tile(np.array(colour, dtype=np.uint8), (*np.shape(points)[:2], 1))

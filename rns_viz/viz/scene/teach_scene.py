@@ -97,7 +97,8 @@ class TeachScene:
             base = self.scene.robot.base_placement()
             at = base.translation + base.rotation @ self._outline_offset
             self.edge_callout.attach(base.rotation, at, self._edge_top)
-        self.ghost.update(q_shadow if view.on("ghost") else None, exaggeration, self._shadow_label(snap))
+        shadow_on = not (snap.readouts.compensating if snap.readouts.dual else snap.settings.suppress)
+        self.ghost.update(q_shadow if view.on("ghost") else None, exaggeration, self._shadow_label(snap), shadow_on)
         self._draw_coupling(snap.readouts.L if view.on("coupling") else None)
         theta = snap.q[self.model.m :]
         self._draw_null(theta if view.on("null_vector") and self.one_d and np.all(np.isfinite(theta)) else None)

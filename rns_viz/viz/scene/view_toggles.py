@@ -44,7 +44,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "Ghost: the shadow run",
         True,
         "A second simulation with the same kicks and inputs but vibration suppression the other way, "
-        "drawn see-through (blue) over the arm.",
+        "drawn see-through over the arm: blue when its run has suppression on, red when off (as the plots).",
     ),
     (
         "reaction",
