@@ -37,10 +37,12 @@ def test_reaction_readout_is_eq1_at_its_step(model: str, peak: float, motion: st
         s.stop()
 
 
-def test_path_words_turn_ubar_into_joint_angles_and_rates() -> None:
+@pytest.mark.parametrize("model", ["trep", "boom7"])
+def test_path_words_turn_ubar_into_joint_angles_and_rates(model: str) -> None:
+    """TREP's two joints and boom7's seven (whose text had named its seventh joint "joint 2")."""
     from rns_viz.viz.panels.path_words import path_words
 
-    s = Session("trep", realtime=False)
+    s = Session(model, realtime=False)
     try:
         assert s.wait_background()
         s.play_slow()
@@ -49,8 +51,9 @@ def test_path_words_turn_ubar_into_joint_angles_and_rates() -> None:
         text = path_words(snap)
         n = snap.readouts.n
         assert n is not None and snap.sigma is not None
-        assert f"joint 2 at **{np.degrees(snap.q[-1]):.1f}°**" in text
-        # theta' = n u-bar (Eq. 27): joint 2's rate at the chosen u-bar, deg/s
-        assert f"joint 2 {np.degrees(abs(n[1]) * snap.settings.ubar_speed):.0f}°/s" in text
+        angles = ", ".join(f"{a:.1f}" for a in np.degrees(snap.q[snap.q.size - len(n) :]))
+        assert f"θ = **({angles})°**" in text  # every joint of the arm, in order
+        # theta' = n u-bar (Eq. 27): the last joint's rate at the chosen u-bar, deg/s
+        assert f"joint {len(n)} {np.degrees(abs(n[-1]) * snap.settings.ubar_speed):.0f}°/s" in text
     finally:
         s.stop()

@@ -26,14 +26,15 @@ class PathWords:
 
 
 def path_words(snap: Snapshot) -> str:
-    """'Joint 2 at 57.3°; at ū = 30 joint 1 turns 1.2°/s, joint 2 5.6°/s' for a 1-D RNS, else ''."""
+    """'Where you are: θ = (90.0, 57.3)°; at ū = 30 joint 1 turns 1.2°/s, joint 2 5.6°/s' for a 1-D RNS, else ''
+    (every joint of the path's arm: boom7's seven, TREP's two)."""
     n = snap.readouts.n
     if n is None or snap.sigma is None or not np.all(np.isfinite(snap.q)):
         return ""
-    theta = np.degrees(snap.q[-len(n) :])
+    theta = ", ".join(f"{a:.1f}" for a in np.degrees(snap.q[-len(n) :]))
     u = snap.settings.ubar_speed  # 1/(kg m s)
     rates = ", ".join(f"joint {i + 1} {math.degrees(abs(v) * u):.0f}°/s" for i, v in enumerate(n))  # n: kg m
     return (
-        f"Where you are: joint 2 at **{theta[-1]:.1f}°** (the paper's ∫ū dt = {snap.sigma:.1f} 1/(kg·m)). "
+        f"Where you are: θ = **({theta})°** (the paper's ∫ū dt = {snap.sigma:.1f} 1/(kg·m)). "
         f"At ū = {u:g} 1/(kg·m·s) the joints turn here at {rates}."
     )
