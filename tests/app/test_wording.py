@@ -146,3 +146,26 @@ def test_the_status_line_says_a_slow_rate_and_a_skip_apart(app: RnsApp) -> None:
     assert "FALLING BEHIND" in slow and "SKIPPED" not in slow
     steady = status_html(replace(snap, rtf=1.0, behind=False, skipped=0.0))
     assert "FALLING BEHIND" not in steady and "SKIPPED" not in steady
+
+
+def test_the_status_line_marks_a_preset_changed_since_it_loaded(app: RnsApp) -> None:
+    """The preset's name stays (its scene and forces run on), with what no longer holds of its description."""
+    from rns_viz.viz.panels.panel_text import status_html
+
+    s = app.session
+    s.load_preset("fig10-on")
+    s.advance(0.0)  # the command taken: the preset is built off the loop ...
+    assert s.wait_background()  # ... and adopted
+    st = s.snapshot().settings
+    assert st.preset == "fig10-on" and "changed since" not in status_html(s.snapshot())
+    g_b = st.gains.g_b
+    s.set_gains(g_b=2 * g_b)
+    s.set_suppression(False)
+    s.advance(0.01)
+    assert "fig10-on</b> <i>(gains, suppression changed since)</i>" in status_html(s.snapshot())
+    s.set_gains(g_b=g_b)
+    s.set_suppression(True)
+    s.advance(0.01)
+    assert "changed since" not in status_html(s.snapshot())  # back to the preset's own
+    s.reset()
+    s.advance(0.01)

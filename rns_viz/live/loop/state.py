@@ -136,7 +136,7 @@ class LiveState:
         choice = runs.adopt_preset_laws()
         st = self.settings
         defaults = Settings.defaults(self.model, st.shadow, st.speed)
-        self.settings = replace(defaults, law=choice.kind, gains=choice.gains, suppress=choice.suppress, preset=name)
+        self.settings = defaults.with_preset(name, choice.kind, choice.gains, choice.suppress)
         self._restart_bookkeeping()
         self.paused = self._preset_paused
         self._request_geometry(runs.theta)

@@ -6,7 +6,7 @@ All immutable; the simulation loop makes new ones and readers take the latest.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -42,6 +42,19 @@ class Settings:
     shadow: bool
     speed: float  # simulated seconds per wall second
     preset: str | None
+    preset_tuning: tuple[LawKind, Gains, bool] | None = None  # the preset's law, gains and suppression as loaded
+
+    def with_preset(self, name: str, law: LawKind, gains: Gains, suppress: bool) -> Settings:
+        """These settings with preset ``name`` loaded at its law, gains and suppression."""
+        return replace(self, law=law, gains=gains, suppress=suppress, preset=name, preset_tuning=(law, gains, suppress))
+
+    def changed_since_preset(self) -> tuple[str, ...]:
+        """What the operator changed since the preset loaded ("law", "gains", "suppression"; () if nothing)."""
+        if self.preset is None or self.preset_tuning is None:
+            return ()
+        law, gains, suppress = self.preset_tuning
+        now = (("law", self.law != law), ("gains", self.gains != gains), ("suppression", self.suppress != suppress))
+        return tuple(name for name, changed in now if changed)
 
     @classmethod
     def defaults(cls, model: FsmsModel, shadow: bool, speed: float) -> Settings:

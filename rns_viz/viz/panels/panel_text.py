@@ -41,6 +41,9 @@ def status_html(snap: Snapshot) -> str:
     elif snap.skipped > 0.0:
         behind = " " + _badge(f"SKIPPED {snap.skipped:.2f} s", WARN_COLOUR)
     preset = f" · preset <b>{st.preset}</b>" if st.preset else ""
+    changed = st.changed_since_preset()  # the preset's description no longer holds for these
+    if changed:
+        preset += f" <i>({', '.join(changed)} changed since)</i>"
     flags = key_selection(st.model)
     if flags is not None:
         preset += f" · S = {''.join(map(str, flags))}"
