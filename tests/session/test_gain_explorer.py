@@ -64,6 +64,6 @@ def test_the_panel_says_why_a_cell_is_not_predictable() -> None:
         now = modes_of(view.map.loop, 3.29, 0.1)
         assert not bool(now.predictable)
         text = predicted_text(view)
-        assert "not predictable" in text and now.why_not() in text and "5 N, 0.2 s kick along x" in text
+        assert f"1/s: **no prediction**, {now.why_not()}" in text and "5 N, 0.2 s kick along x" in text
     finally:
         s.stop()

@@ -278,16 +278,16 @@ def _fmt_time(seconds: float) -> str:
 
 
 def _prediction(view: GainView) -> str:
-    """The predicted decay at the gains in force, or why there is none."""
+    """The predicted decay at the gains in force, or why there is none (what follows "Base decay at ...: ")."""
     now = view.current
     if now is None:
-        return "…"
+        return "predicted …"
     if not bool(now.stable):
-        return f"none: the loop is unstable (σ_b {_fmt_rate(float(now.base_decay_rate))})"
+        return f"no prediction, the loop is unstable (σ_b {_fmt_rate(float(now.base_decay_rate))})"
     why = now.why_not()
     if why:
-        return f"**not predictable**: {why}"
-    return f"σ_b {_fmt_rate(float(now.base_decay_rate))}, {_fmt_time(float(now.base_time_to_10pct))}"
+        return f"**no prediction**, {why}"
+    return f"predicted σ_b {_fmt_rate(float(now.base_decay_rate))}, {_fmt_time(float(now.base_time_to_10pct))}"
 
 
 def predicted_text(view: GainView) -> str:
@@ -296,7 +296,7 @@ def predicted_text(view: GainView) -> str:
     view's model, law, gains and run is shown."""
     gains = f"g_b = {view.gains.g_b:.4g}, g_m = {view.gains.g_m:.4g} 1/s"
     if view.analysed:
-        pred = f"**Base decay** at {gains}: predicted {_prediction(view)}"
+        pred = f"**Base decay** at {gains}: {_prediction(view)}"
         if view.map is not None and view.current is not None and bool(view.current.stable):
             pred += f" ({view.map.loop.regime}; the arm swings {float(view.current.swing):.2g} rad)"
     else:
