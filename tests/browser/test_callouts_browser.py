@@ -84,7 +84,7 @@ OVER_CANVAS = """([x, y, width, height, step]) => {
   return [...boxes.values()];
 }"""
 OVER_CANVAS_STEP = 8
-TRIES = 3  # views read per size: again while the view moved between its first and last frame
+TRIES = 5  # views read per size: again while the view moved between its first and last frame
 
 
 def show(page, shown: list, hidden: list) -> None:  # type: ignore[no-untyped-def]
