@@ -176,6 +176,26 @@ def test_labels_keep_off_the_gain_map_while_it_is_shown(trep_app: RnsApp) -> Non
     assert len(callouts.solids()) == len(arm)
 
 
+def test_labels_keep_clear_of_a_paced_pages_slowed_line(trep_app: RnsApp) -> None:
+    """A paced page's floating panel carries the "Display slowed" line: its box for the labels' layout grows."""
+    from rns_viz.viz.scene.framing import NOTICE_HEIGHT_PX
+
+    app = trep_app
+    assert app.renderer.page_notice == app.pace.noticed  # the pace tells the labels' layout
+    callouts = app.renderer.callouts
+    with ProtocolClient(app.port) as ws:
+        wait_for_clients(app, 1, "the page")
+        ws.camera((1.0, 0.0, 0.0, 0.0), (5.0, 5.0, 5.0), size=(1200, 700))
+        wait_until(lambda: bool(callouts.pages()), 10.0, "the page's camera")
+        plain = callouts.pages()[0].covered
+        app.renderer.page_notice = lambda client_id: True
+        try:
+            slowed = callouts.pages()[0].covered
+        finally:
+            app.renderer.page_notice = app.pace.noticed
+        assert plain is not None and slowed is not None and slowed[3] == plain[3] + NOTICE_HEIGHT_PX
+
+
 def test_other_paths_toggle_draws_the_family_or_only_the_current_path(trep_app: RnsApp) -> None:
     app = trep_app
     paths = app.server.scene.get_handle_by_name(FsmsScene.PATHS)

@@ -24,3 +24,14 @@ def test_a_phone_is_narrow_and_a_desktop_wide_at_any_density(density: float) -> 
 
 def test_no_size_yet_is_not_narrow() -> None:
     assert not is_narrow(0, 0) and not is_narrow(390, 0)
+
+
+def test_a_paced_pages_panel_covers_its_slowed_line_too() -> None:
+    """The slowed-display line joins the floating panel of a paced page: the box the labels keep clear of grows
+    by its height there, and only there (a phone's panel is a sheet below the band: no box either way)."""
+    from rns_viz.viz.scene.framing import NOTICE_HEIGHT_PX, main_panel_box
+
+    plain, slowed = main_panel_box(614, 768), main_panel_box(614, 768, notice=True)
+    assert plain is not None and slowed is not None
+    assert slowed[:3] == plain[:3] and slowed[3] == plain[3] + NOTICE_HEIGHT_PX
+    assert main_panel_box(390, 844, notice=True) is None

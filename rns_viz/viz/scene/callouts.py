@@ -37,8 +37,9 @@ STILL_PX = 0.5 * CELL_PX  # a layout is skipped while no page's projected point 
 LEADER_COLOUR = (90, 90, 90)
 
 
-def page_camera(client: viser.ClientHandle) -> PageCamera | None:
-    """The camera a page last reported, or None before its first report."""
+def page_camera(client: viser.ClientHandle, notice: bool = False) -> PageCamera | None:
+    """The camera a page last reported, or None before its first report; ``notice``: its floating panel
+    shows the slowed-display line (and covers more of the scene)."""
     cam = client.camera
     if cam.update_timestamp == 0.0 or cam.image_width <= 0 or cam.image_height <= 0:
         return None
@@ -46,7 +47,7 @@ def page_camera(client: viser.ClientHandle) -> PageCamera | None:
     position, width, height = np.asarray(cam.position, dtype=float), cam.image_width, cam.image_height
     bottom, top = band_for(width, height)  # NDC y: a phone's panel sheet covers the page below the band
     shown = ((1.0 - top) / 2.0 * height, (1.0 - bottom) / 2.0 * height)
-    return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width, height))
+    return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width, height, notice))
 
 
 @dataclass(eq=False)  # one callout is itself only (``in`` must not compare its arrays)
@@ -124,11 +125,12 @@ class Callouts:
     def _seen(
         live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray
     ) -> tuple[list[str], list[np.ndarray]]:
-        """What a layout depends on: the callouts' words, and on each page the points and solids' pixels."""
+        """What a layout depends on: the callouts' words, and on each page its size, the box its floating panel
+        covers, and the points' and solids' pixels."""
         points = np.array([item.point for item in live], dtype=float)
         world = np.concatenate([points, solids.reshape(-1, 3)])
         return [item.text for item in live], [
-            np.r_[page.width, page.height, page.project(world)[0].ravel()] for page in pages
+            np.r_[page.width, page.height, page.covered or (), page.project(world)[0].ravel()] for page in pages
         ]
 
     def _same(self, seen: tuple[list[str], list[np.ndarray]]) -> bool:

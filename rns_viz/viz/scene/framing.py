@@ -32,6 +32,7 @@ NARROW_BAND = (0.2, 0.95)  # NDC y band (bottom, top) the robot is fitted into o
 # who operates); callouts keep off it
 MAIN_PANEL_PX = (-12, 12, 300)
 MAIN_PANEL_HEIGHT_PX = 190
+NOTICE_HEIGHT_PX = 120  # px the floating panel grows by while a paced page's slowed-display line shows (~108)
 PAD_REACH = 0.2  # the box grows by this fraction of the arm's reach on every side: links have thickness
 CLAMP_REACHES = 1.5  # the clamp at the origin is framed if it is within this many arm reaches of the base
 DEFAULT_FOV = 1.309  # rad, viser's vertical field of view
@@ -105,11 +106,13 @@ def band_for(width: float, height: float) -> tuple[float, float]:
     return NARROW_BAND if is_narrow(width, height) else (-1.0, 1.0)
 
 
-def main_panel_box(width: float, height: float) -> tuple[float, float, float, float] | None:
+def main_panel_box(width: float, height: float, notice: bool = False) -> tuple[float, float, float, float] | None:
     """The floating main panel's box (x0, y0, x1, y1) on a scene of this size, in its px (taken as CSS px:
-    a dense screen's is smaller); None on a phone's (a sheet there, below the band of :func:`band_for`)."""
+    a dense screen's is smaller); None on a phone's (a sheet there, below the band of :func:`band_for`).
+    ``notice``: the page is paced and its panel carries the slowed-display line (NOTICE_HEIGHT_PX more)."""
     if is_narrow(width, height):
         return None
     x, y, panel_width = MAIN_PANEL_PX
     right = width + x if x < 0 else x + panel_width
-    return (right - panel_width, float(y), float(right), float(y + MAIN_PANEL_HEIGHT_PX))
+    bottom = y + MAIN_PANEL_HEIGHT_PX + (NOTICE_HEIGHT_PX if notice else 0.0)
+    return (right - panel_width, float(y), float(right), float(bottom))

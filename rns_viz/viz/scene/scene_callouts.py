@@ -3,6 +3,8 @@ placed off both arms."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import viser
 
@@ -25,10 +27,12 @@ class SceneCallouts:
         ghost: Ghost,
         handle: viser.TransformControlsHandle | None,
         connections: Connections | None,
+        notice: Callable[[int], bool] = lambda client_id: False,
     ) -> None:
         """``handle`` None: no "drag me"; ``connections`` None (a recording's export): no pages, so every
-        label is drawn at its point."""
+        label is drawn at its point; ``notice(client_id)``: the page's panel shows the slowed-display line."""
         self.server, self.scene, self.ghost, self.handle, self.connections = server, scene, ghost, handle, connections
+        self.notice = notice
         self.callouts = scene.callouts  # the base's callout is the scene's own
         self.drag = None
         if handle is not None:  # its frame: the handle's parent (FsmsScene.BASE_AT_REST), its point: the handle
@@ -59,7 +63,7 @@ class SceneCallouts:
         allowed = self.connections.allowed
         clients = sorted(self.server.get_clients().items())
         clients.sort(key=lambda item: not allowed(item[1]))
-        cameras = (page_camera(client) for _, client in clients)
+        cameras = (page_camera(client, self.notice(client_id)) for client_id, client in clients)
         return [cam for cam in cameras if cam is not None]
 
     def solids(self) -> np.ndarray:

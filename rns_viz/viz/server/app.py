@@ -95,6 +95,7 @@ class RnsApp:
         self.renderer.text_panels += [self.replay.refresh, self.rank_inset.refresh]
         # each page gets updates at the rate it can draw; told so under the status line when slowed
         self.pace = ClientPace(server, enabled=pace, notice_order=self.gui.status.order + 0.1)
+        self.renderer.page_notice = self.pace.noticed  # the scene's labels keep clear of that line
         self.keys = add_key_commands(server.gui, self.gui, self.controls, session, self.frame_robot, self._jog_setup)
         self.gui.frame_robot.on_click(lambda event: self.frame_robot(event.client))
         self.present_style: viser.GuiHtmlHandle | None = None  # the projector's text size (--present)

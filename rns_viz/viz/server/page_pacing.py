@@ -196,6 +196,11 @@ class ClientPace:
         self.pages[client.client_id] = page
         page.start()
 
+    def noticed(self, client_id: int) -> bool:
+        """Whether the page's panel shows the slowed-display line now."""
+        page = self.pages.get(client_id)
+        return page is not None and bool(page.state()["notice"])
+
     def client_left(self, client_id: int) -> None:
         page = self.pages.pop(client_id, None)
         if page is not None:

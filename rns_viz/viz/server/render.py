@@ -64,6 +64,7 @@ class Renderer:
         self.base_panel = base_panel
         self.view = view or ViewToggles({})
         self.text_panels: list[Callable[[Snapshot], None]] = []  # more panels refreshed with the text (5 Hz)
+        self.page_notice: Callable[[int], bool] = lambda client_id: False  # a page's panel shows the slowed line
         self.session = session
         self.gui = gui
         self.controls = controls
@@ -120,7 +121,9 @@ class Renderer:
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
             self.view.boxes["rank"].visible = has_rank_inset(self.model)
-        self.callouts = SceneCallouts(self.server, self.scene, self.teach.ghost, self.handle, self.connections)
+        self.callouts = SceneCallouts(
+            self.server, self.scene, self.teach.ghost, self.handle, self.connections, lambda cid: self.page_notice(cid)
+        )
         self.scene.set_target(snap.target)
         self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
 
