@@ -169,3 +169,14 @@ def test_the_status_line_marks_a_preset_changed_since_it_loaded(app: RnsApp) -> 
     assert "changed since" not in status_html(s.snapshot())  # back to the preset's own
     s.reset()
     s.advance(0.01)
+
+
+def test_g_m_is_named_for_what_it_does_under_the_law(app: RnsApp) -> None:
+    """g_m damps joint motion in (15)/(16) and pulls the joints to their reference in (30): its label says which."""
+    from tests.support.browser import wait_until
+
+    s, box = app.session, app.gui.gains["g_m"].slider
+    for law, label in (("acceleration", "Joint damping g_m (1/s)"), ("velocity", "Joint hold g_m (1/s)")):
+        s.set_law(law)
+        s.advance(0.01)
+        wait_until(lambda label=label: box.label == label, 5.0, f"g_m labelled {label!r} under law {law}")

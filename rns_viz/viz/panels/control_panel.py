@@ -32,6 +32,12 @@ PLOTS_WIDTH_PX = 360  # the docked plots' width: a 1366 px screen keeps ~600 px 
 CONTROLS_WIDTH_PX = 384  # the docked controls' width (viser's "large" control panel)
 SPEED_LABELS = {0.125: "1/8×", 0.25: "1/4×", 0.5: "1/2×", 1.0: "1×", 2.0: "2×"}
 
+# g_m's label under each law: joint damping in (15)/(16), the pull to the joint reference in (30)
+G_M_LABELS: dict[str, str] = {
+    "acceleration": "Joint damping g_m (1/s)",
+    "torque": "Joint damping g_m (1/s)",
+    "velocity": "Joint hold g_m (1/s)",
+}
 # (name, label, min, max, step, hint) of every gain slider; units in the labels.
 GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     (
@@ -44,7 +50,7 @@ GAIN_SLIDERS: tuple[tuple[str, str, float, float, float, str], ...] = (
     ),
     (
         "g_m",
-        "Joint hold g_m (1/s)",
+        "Joint hold g_m (1/s)",  # relabelled with the law: G_M_LABELS
         0.0,
         100.0,
         0.1,

@@ -35,7 +35,13 @@ GLOSSARY: tuple[tuple[str, str, str, str], ...] = (
         "Eq. (24)",
     ),
     ("damping gain", "g_b", "how hard the arm fights the base's swing, 1/s", "Eqs. (15), (16), (30)"),
-    ("holding gain", "g_m", "how firmly the joints are held, 1/s", "Eqs. (15), (16), (30)"),
+    (
+        "joint gain",
+        "g_m",
+        "law (30): how firmly the joints are held to their reference (Joint hold); laws (15), (16): how strongly "
+        "joint motion that pushes the base is damped (Joint damping), 1/s",
+        "Eqs. (15), (16), (30)",
+    ),
     ("decay rate", "σ_b", "how fast the base's swing dies out (bigger is faster), 1/s", "gain map"),
     (
         "ghost run (shadow run)",

@@ -25,7 +25,7 @@ from rns_viz.live.teaching.rank_view import has_rank_inset
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.base_panel import BasePanel
-from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements
+from rns_viz.viz.panels.control_panel import G_M_LABELS, SPEED_LABELS, GuiElements
 from rns_viz.viz.panels.gain_panel import GainExplorerView
 from rns_viz.viz.panels.inputs import Controls
 from rns_viz.viz.panels.live_plots import COMPENSATION_SIDES, SUPPRESSION_SIDES
@@ -348,6 +348,8 @@ class Renderer:
         show(g.suppression, st.suppress)
         for name, slider in g.gains.items():
             show(slider, float(getattr(st.gains, name)))
+        if g.gains["g_m"].slider.label != G_M_LABELS[st.law]:  # what g_m does differs by law
+            g.gains["g_m"].slider.label = G_M_LABELS[st.law]
         show(g.ubar_speed, st.ubar_speed)
         show(g.target_speed, st.target_speed)
         show(g.shadow, st.shadow)
