@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from rns_viz.cli import main
+from rns_viz.live.loop import wall_clock
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.params import ASSETS_DIR
 from rns_viz.viz.panels.base_panel import BasePanel
@@ -162,5 +163,22 @@ def test_a_model_file_with_its_own_app_table_is_offered_with_its_label_presets_l
         app.session.kick(1.5)
         app.session.advance(0.2)
         assert np.max(np.abs(app.session.plot_arrays()["xb_1"])) > 0.0
+    finally:
+        app.stop()
+
+
+def test_a_new_models_time_runs_from_when_its_scene_is_drawn(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Building a model's scene takes the interpreter for a second or more, which the loop would then drop as
+    a stall (the status line said SKIPPED 3.60 s after every switch): once built, the clock starts again."""
+    monkeypatch.setattr(wall_clock, "SKIPPED_HOLD_S", 600.0)  # a skip is forgotten by the restart, not by age
+    app = start_app("trep", port=0, verbose=False)
+    try:
+        pacer = app.session.pacer
+        wait_until(lambda: app.session.snapshot().t > 0.2, 20.0, "TREP running")
+        pacer.drop_backlog(app.session.snapshot().t)  # as after a stall: a skip reported ...
+        app.session.switch_model("planar3r")
+        wait_until(lambda: app.renderer.model_name == "planar3r", 30.0, "the 3R's scene built")
+        wait_until(lambda: app.session.snapshot().t > 0.1, 20.0, "the 3R running")
+        assert pacer.skipped() == 0.0  # ... forgotten once the new scene was drawn
     finally:
         app.stop()

@@ -142,6 +142,7 @@ def test_the_status_line_says_a_slow_rate_and_a_skip_apart(app: RnsApp) -> None:
     snap = replace(app.session.snapshot(), paused=False, diverged=None)
     caught_up = status_html(replace(snap, rtf=1.14, behind=False, skipped=0.31))
     assert "SKIPPED 0.31 s" in caught_up and "FALLING BEHIND" not in caught_up and "1.14× real time" in caught_up
+    assert 'title="The processor was busy elsewhere' in caught_up  # what it means, on hovering it
     slow = status_html(replace(snap, rtf=0.7, behind=True, skipped=0.0))
     assert "FALLING BEHIND" in slow and "SKIPPED" not in slow
     steady = status_html(replace(snap, rtf=1.0, behind=False, skipped=0.0))

@@ -112,3 +112,12 @@ def test_behind_is_relative_to_the_chosen_speed(clock: Clock) -> None:
     for k in range(11):  # exactly half speed
         p.sample(0.05 * k, start + 0.1 * k)
     assert p.rtf() == pytest.approx(0.5) and not p.behind()
+
+
+def test_a_restart_forgets_the_backlog_and_the_skips(clock: Clock) -> None:
+    p = Pacer(1.0)
+    clock.now += 0.8
+    p.drop_backlog(0.3)
+    clock.now += 0.4  # a backlog again
+    p.restart(0.3)
+    assert p.skipped() == 0.0 and p.backlog(0.3, clock.now) == 0.0

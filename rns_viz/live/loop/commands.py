@@ -72,6 +72,11 @@ class Resume(Command):
 
 
 @dataclass(frozen=True)
+class RestartClock(Command):
+    pass  # pace from now (a new model's scene was being built); handled by the session, not the state
+
+
+@dataclass(frozen=True)
 class SingleStep(Command):
     count: int = 1  # simulation steps of 1 ms
 

@@ -128,6 +128,11 @@ class Session:
         """True once :meth:`stop` was called (the loop ends)."""
         return self._stop
 
+    def restart_clock(self) -> None:
+        """Pace from now on, forgetting a backlog and the time skipped so far (a page's view of a new model
+        was being built: the time that took is not simulated time anyone missed)."""
+        self.send(c.RestartClock())
+
     def stop(self) -> None:
         self._stop = True
         self._wake.set()
@@ -291,6 +296,9 @@ class Session:
         state = self.state
         while self._commands:
             cmd = self._commands.popleft()
+            if isinstance(cmd, c.RestartClock):  # the pacing's, not the simulation's
+                self.pacer.restart(state.runs.t)
+                continue
             try:
                 with self._lock:
                     state.apply(cmd)

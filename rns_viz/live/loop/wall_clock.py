@@ -30,6 +30,11 @@ class Pacer:
         self.anchor_sim = sim_t
         self._samples.clear()
 
+    def restart(self, sim_t: float) -> None:
+        """:meth:`reanchor`, and no skip reported any more."""
+        self.reanchor(sim_t)
+        self._skipped, self._last_drop = 0.0, -1e9
+
     def set_speed(self, speed: float, sim_t: float) -> None:
         if speed not in SPEEDS:
             raise ValueError(f"speed must be one of {SPEEDS}, got {speed}")

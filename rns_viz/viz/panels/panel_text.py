@@ -17,11 +17,20 @@ WARN_COLOUR = "#c77700"
 BAD_COLOUR = "#c0262d"
 
 
-def _badge(text: str, colour: str) -> str:
+def _badge(text: str, colour: str, why: str = "") -> str:
+    """A coloured word; ``why``: what it means, shown on hovering it."""
+    title = f' title="{html.escape(why)}"' if why else ""
     return (
         f'<span style="background:{colour};color:white;border-radius:4px;padding:1px 6px;'
-        f'font-weight:600;font-size:0.8em">{text}</span>'
+        f'font-weight:600;font-size:0.8em"{title}>{text}</span>'
     )
+
+
+BEHIND_WHY = "This machine cannot simulate at the chosen speed: the factor beside says how fast it runs."
+SKIPPED_WHY = (
+    "The processor was busy elsewhere for longer than a quarter of a second: the simulation gave up that much "
+    "simulated time rather than run fast to catch up. The plots show the simulation's own time."
+)
 
 
 def status_html(snap: Snapshot) -> str:
@@ -37,9 +46,9 @@ def status_html(snap: Snapshot) -> str:
     rtf = "–" if snap.paused or not math.isfinite(snap.rtf) else f"{snap.rtf:.2f}"
     behind = ""  # the rate beside it says by how much; a skip after a stall is said apart (the rate may be back)
     if snap.behind:
-        behind = " " + _badge("FALLING BEHIND", BAD_COLOUR)
+        behind = " " + _badge("FALLING BEHIND", BAD_COLOUR, BEHIND_WHY)
     elif snap.skipped > 0.0:
-        behind = " " + _badge(f"SKIPPED {snap.skipped:.2f} s", WARN_COLOUR)
+        behind = " " + _badge(f"SKIPPED {snap.skipped:.2f} s", WARN_COLOUR, SKIPPED_WHY)
     preset = f" · preset <b>{st.preset}</b>" if st.preset else ""
     changed = st.changed_since_preset()  # the preset's description no longer holds for these
     if changed:

@@ -154,6 +154,7 @@ class Renderer:
         self._seen = _Seen()
         self.sync_settings(snap)
         self.model_name = snap.settings.model
+        self.session.restart_clock()  # the new model's time runs from when its scene is drawn
 
     # ---------------------------------------------------------------- the loop
     def _loop(self) -> None:
