@@ -134,12 +134,13 @@ class Operator(ABC):
 
     # -- new configuration or overlays ---------------------------------------------------------
     def re_anchor(self, theta: np.ndarray) -> None:
-        """Hold at ``theta`` (the arm's configuration) from now on; forgets the path table."""
+        """Hold at ``theta`` (the arm's configuration) from now on; forgets the path table. The mode says so: the
+        hand's miss is measured from here on (its plot falls to about zero although the hand did not move)."""
         theta = np.array(theta, dtype=float)
         self.joint = JointSample.held(theta)
         self.joint_move = None
         self._hold_at(theta)
-        self.mode = "holding"
+        self.mode = "holding where it came to rest (the reference moved there: the hand's miss restarts from 0)"
 
     @abstractmethod
     def _hold_at(self, theta: np.ndarray) -> None: ...

@@ -104,7 +104,9 @@ def _chart(
 
 PLOTS_CAPTION = (
     '<div style="font-size:0.75em;opacity:0.8">The last 10 s: how far the base is bent, x_b; the momentum '
-    "the arm's joints hand to the base, L (1 mN·s = 1 g·m/s); how far the hand is from where it is sent, |e|. "
+    "the arm's joints hand to the base, L (1 mN·s = 1 g·m/s); how far the hand is from where it is sent, |e| "
+    "(when a kicked arm comes to rest on another reactionless path it is sent to where it rests, and |e| "
+    "falls to about 0: the status line then says so). "
     "Each axis is in the unit its numbers read best in; less than 1 nm or 1 nN·s is drawn as 0. {runs}</div>"
 )
 # (blue header, red header, note) of the peaks table, the legend's two names and the caption's sentence on
