@@ -17,7 +17,7 @@ from rns_viz.viz.scene.callout_layout import (
     convex_hull,
     text_size,
 )
-from rns_viz.viz.scene.callouts import Callout, Callouts
+from rns_viz.viz.scene.callouts import Callout, Callouts, FixedText
 
 
 def look_at(eye: np.ndarray, target: np.ndarray, width: int = 800, height: int = 600) -> PageCamera:
@@ -159,3 +159,21 @@ def test_taken_cells_counted_as_the_cells_under_the_box_after_every_addition() -
             )
             want = int(np.count_nonzero(page.cells[j0:j1, i0:i1])) if i1 > i0 and j1 > j0 else 0
             assert page.taken(box) == want, box
+
+
+def test_a_written_text_is_kept_clear_of_like_a_solid() -> None:
+    """The gain map's title and legend (several lines) are written in the scene: a callout whose place is on
+    one of them gives it up, and its box is then off the text's whole box (every line of it)."""
+    cam = look_at(np.array([0.0, -2.0, 0.0]), np.zeros(3))
+    item = Callout(None, None, "drag me", point=np.zeros(3))  # type: ignore[arg-type]
+    item.placement = Placement((22.0, 0.0), "center-left")  # right of the point ...
+    legend = FixedText(np.array([0.02, 0.0, 0.05]), "top-left", "line one\nline two, longer\nline three")  # ... there
+    no_solids = np.zeros((0, 8, 3))
+    Callouts(None)._layout([item], [cam], no_solids, [legend])  # type: ignore[arg-type]
+    at, _ = cam.project(legend.point)
+    width, height = text_size(legend.text)
+    assert height > text_size("line one")[1] + 30  # three lines are taller than one
+    page = Occupancy(cam.width, cam.height)
+    page.add_box(box_at(at, legend.anchor, (width, height)))
+    assert page.taken(_label_box(cam, item)) == 0
+    assert item.placement is not None and item.placement.offset != (22.0, 0.0)

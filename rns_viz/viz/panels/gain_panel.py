@@ -91,7 +91,7 @@ class GainExplorerView:
             "Gain explorer", order=gui.download.order - 0.5, expand_by_default=True
         ) as self.folder:  # above Download
             g.add_markdown(
-                "**Gain map** in the scene (left of the robot; tick *Gain map* in *Show in the scene*): each cell is a "
+                "**Gain map** in the scene (above the robot; tick *Gain map* in *Show in the scene*): each cell is a "
                 "(g_b, g_m) setting, coloured by how fast the closed loop, linearised about the current pose, damps a "
                 "kick (the one in the map's title; faded, hatched cells: it cannot say). "
                 "**Click a cell** to apply its gains."
@@ -125,7 +125,7 @@ class GainExplorerView:
 
     def show(self, on: bool, robot_scene: FsmsScene) -> None:
         """Show or hide the map and the authority overlay in the scene (the *Gain map* toggle). Every camera
-        then frames what is shown: the robot, with the map while it is shown (it stands left of the robot,
+        then frames what is shown: the robot, with the map while it is shown (it stands above the robot,
         out of a view framed on the robot alone); *Frame robot* does the same."""
         if self.scene is None or not self.scene.set_shown(on):
             return

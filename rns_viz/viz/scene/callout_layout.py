@@ -67,9 +67,13 @@ class PageCamera:
         return self.position + self.rotation @ np.array([xy[0], xy[1], depth])
 
 
+LINE_PX = 16.0  # px each further line of a label adds (viser's labels break lines at newlines)
+
+
 def text_size(text: str) -> tuple[float, float]:
-    """A label's box on the page (width, height), px."""
-    return CHAR_PX * len(text) + PAD_PX, HEIGHT_PX
+    """A label's box on the page (width, height), px: its longest line's width, its lines' height."""
+    lines = text.split("\n")
+    return CHAR_PX * max(len(line) for line in lines) + PAD_PX, HEIGHT_PX + LINE_PX * (len(lines) - 1)
 
 
 def box_at(point: np.ndarray, anchor: str, size: tuple[float, float]) -> np.ndarray:

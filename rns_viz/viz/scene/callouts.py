@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import viser
@@ -48,6 +49,14 @@ def page_camera(client: viser.ClientHandle, notice: bool = False) -> PageCamera 
     bottom, top = band_for(width, height)  # NDC y: a phone's panel sheet covers the page below the band
     shown = ((1.0 - top) / 2.0 * height, (1.0 - bottom) / 2.0 * height)
     return PageCamera(position, rotation, float(cam.fov), width, height, shown, main_panel_box(width, height, notice))
+
+
+class FixedText(NamedTuple):
+    """A label written at a fixed place in the scene (not a callout): callouts keep off its box."""
+
+    point: np.ndarray  # world, m
+    anchor: str  # viser's anchor of the label at ``point``
+    text: str
 
 
 @dataclass(eq=False)  # one callout is itself only (``in`` must not compare its arrays)
@@ -105,31 +114,33 @@ class Callouts:
         pages: Callable[[], Sequence[PageCamera]],
         solids: Callable[[], np.ndarray],
         labels_on: bool,
+        texts: Callable[[], Sequence[FixedText]] = lambda: (),
     ) -> None:
         """Place the callouts if it is time (``pages()``: the pages' cameras, primary first; ``solids()``:
-        (L, 8, 3) world corners of what no label may cover) and send what changed."""
+        (L, 8, 3) world corners of what no label may cover; ``texts()``: other labels written in the scene,
+        which no callout may cover either) and send what changed."""
         live = [c for c in self.items.values() if labels_on and c.shown and _finite(c.point)]
         if live and now >= self.next_layout:
             self.next_layout = now + LAYOUT_S
             cameras = pages()
             if cameras:  # no page: the labels stay where they were
-                corners = solids()
-                seen = self._seen(live, cameras, corners)
+                corners, fixed = solids(), list(texts())
+                seen = self._seen(live, cameras, corners, fixed)
                 if not self._same(seen):
                     self._laid_out = seen
-                    self._layout(live, cameras, corners)
+                    self._layout(live, cameras, corners, fixed)
         for item in self.items.values():
             self._draw(item, item in live)
 
     @staticmethod
     def _seen(
-        live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray
+        live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray, fixed: Sequence[FixedText] = ()
     ) -> tuple[list[str], list[np.ndarray]]:
         """What a layout depends on: the callouts' words, and on each page its size, the box its floating panel
         covers, and the points' and solids' pixels."""
-        points = np.array([item.point for item in live], dtype=float)
+        points = np.array([item.point for item in live] + [text.point for text in fixed], dtype=float)
         world = np.concatenate([points, solids.reshape(-1, 3)])
-        return [item.text for item in live], [
+        return [item.text for item in live] + [text.text for text in fixed], [
             np.r_[page.width, page.height, page.covered or (), page.project(world)[0].ravel()] for page in pages
         ]
 
@@ -142,12 +153,18 @@ class Callouts:
             for a, b in zip(last[1], seen[1], strict=True)
         )
 
-    def _layout(self, live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray) -> None:
+    def _layout(
+        self, live: list[Callout], pages: Sequence[PageCamera], solids: np.ndarray, fixed: Sequence[FixedText] = ()
+    ) -> None:
         occupied = []
         for page in pages:
             grid = Occupancy(page.width, page.height, page.shown)
             if page.covered is not None:
                 grid.add_box(np.array(page.covered))
+            for text in fixed:
+                at, depth = page.project(text.point)
+                if np.all(np.isfinite(at)) and depth > 0:
+                    grid.add_box(box_at(at, text.anchor, text_size(text.text)), GAP_PX)
             for corners in page.project(solids)[0] if len(solids) else ():
                 grid.add_solid(corners)
             for item in live:

@@ -30,6 +30,7 @@ from rns_viz.viz.scene.framing import (
     frame_points,
     framed_points,
     is_narrow,
+    main_panel_box,
 )
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
@@ -270,12 +271,15 @@ class FsmsScene:
             for client in self.server.get_clients().values():
                 self.frame_client(client)
 
-    def camera_pose(self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, narrow: bool = False) -> CameraPose:
+    def camera_pose(
+        self, fov: float = DEFAULT_FOV, aspect: float = DEFAULT_ASPECT, narrow: bool = False, top: float = 1.0
+    ) -> CameraPose:
         """Where a camera of this field of view and aspect sees the robot framed (framing.py), with the
-        points of :meth:`frame_also`; ``narrow``: a phone's page (the robot above viser's sheet)."""
+        points of :meth:`frame_also`; ``narrow``: a phone's page (the robot above viser's sheet); ``top``: the
+        NDC height the framed points stay under on a wide page."""
         direction = np.subtract(self.style.camera_position, self.style.camera_look_at)
         points = self.framed if self.also_framed is None else np.vstack([self.framed, self.also_framed])
-        return frame_points(points, direction, fov, aspect, band=NARROW_BAND if narrow else (-1.0, 1.0))
+        return frame_points(points, direction, fov, aspect, band=NARROW_BAND if narrow else (-1.0, top))
 
     def frame_also(self, points: np.ndarray | None) -> None:
         """Frame the world ``points`` (N, 3), m, with the robot from now on (None: the robot alone), and
@@ -288,7 +292,10 @@ class FsmsScene:
         cam = client.camera
         width, height = cam.image_width, cam.image_height
         aspect = width / height if width > 0 and height > 0 else DEFAULT_ASPECT
-        pose = self.camera_pose(cam.fov, aspect, is_narrow(width, height))
+        top, panel = 1.0, main_panel_box(width, height)
+        if self.also_framed is not None and panel is not None and height > 0:  # the map's top and title: below
+            top = 1.0 - 2.0 * min(panel[3] / height, 0.5)  # the floating panel (the robot alone may reach under it)
+        pose = self.camera_pose(cam.fov, aspect, is_narrow(width, height), top)
         with client.atomic():
             cam.up_direction = (0.0, 0.0, 1.0)
             cam.position = pose.position  # (viser moves look_at with the position: it is set after)

@@ -21,6 +21,7 @@ import viser.transforms as vtf
 
 from rns_viz.analysis import GainMap
 from rns_viz.live.explorer.gain_explorer import GainView
+from rns_viz.viz.scene.callouts import FixedText
 from rns_viz.viz.scene.style import SceneStyle
 
 Quantity = Literal["base", "time", "arm"]
@@ -39,6 +40,8 @@ NOW_COLOUR = (255, 255, 255)
 IMAGE_TURN = tuple(vtf.SO3.from_x_radians(math.pi).wxyz)
 PAPER_COLOUR = (20, 20, 20)
 LABEL_ROOM = 0.15  # x the map's side: the title above it, the legend below, the tick labels left of it
+MAP_SIZE = 0.5  # the map's side, x the distance of the model's camera to the robot
+MAP_UP = 0.9  # the map's centre above the robot's, x that distance (the robot spans about +-0.4 of it)
 # viridis at 0, 1/4, 1/2, 3/4, 1 (slow decay dark, fast decay yellow)
 _ANCHORS = np.array([[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]], dtype=float)
 
@@ -145,9 +148,10 @@ class GainScene:
         up = np.cross(right, ahead)
         self.rotation = np.column_stack([right, up, -ahead])  # map x: g_b, y: g_m, z: towards the camera
         distance = float(np.linalg.norm(look - cam))
-        self.size = 0.36 * distance  # m, side of the map
-        # up and to the left of the robot, a little towards the camera: clear of the base drawing
-        self.centre = look + distance * (-0.5 * right + 0.27 * up - 0.2 * ahead)
+        self.size = MAP_SIZE * distance  # m, side of the map
+        # above the robot as the model's camera frames it, a little towards the camera: clear of the arm and its
+        # base, and stacked so that the scene between the docked panels (taller than wide on a laptop) holds both
+        self.centre = look + distance * (MAP_UP * up - 0.2 * ahead)
         self.frame = scene.add_frame(
             self.FRAME,
             wxyz=vtf.SO3.from_matrix(self.rotation).wxyz,
@@ -233,6 +237,16 @@ class GainScene:
             if not on:
                 self.authority.visible = self.authority_lines.visible = False
         return True
+
+    def texts(self) -> list[FixedText]:
+        """The title and the legend while the map is shown: callouts keep off them (their lines run past the
+        map's sides)."""
+        if not (self.shown and self.gain_map is not None):
+            return []
+        return [
+            FixedText(self.centre + self.rotation @ np.asarray(label.position, dtype=float), label.anchor, label.text)
+            for label in (self.title, self.legend)
+        ]
 
     def framed_corners(self) -> np.ndarray:
         """World corners (4, 3), m, of the map with room for its title, legend and axis ticks around it."""
@@ -360,8 +374,8 @@ def _title(view: GainView, quantity: Quantity) -> str:
         "time": "base time to 10 % of its peak (s)",
         "arm": "arm mode decay rate σ_a (1/s)",
     }[quantity]
-    regime = f" {view.map.loop.regime}" if view.map is not None else ""
-    return f"Gain map, law {_law_eq(view)}{regime}: {what} — click a cell to apply its gains"
+    regime = "" if view.map is None else "\n" + view.map.loop.regime.replace(", arm at rest", ",\narm at rest")
+    return f"Gain map, law {_law_eq(view)}: {what}{regime}\nclick a cell to apply its gains"
 
 
 def _legend(quantity: Quantity, scale: tuple[float, float]) -> str:
@@ -371,8 +385,8 @@ def _legend(quantity: Quantity, scale: tuple[float, float]) -> str:
     else:
         sym = "σ_a" if quantity == "arm" else "σ_b"
         span = f"{sym}: dark {lo:.3g} … yellow {hi:.3g} 1/s (log)"
-    marks = "hatched grey: unstable; faded, hatched \\: not predictable for this kick (the panel says why)"
-    return f"{span}; {marks}; white: now; black: paper"
+    marks = "grey, hatched: unstable\nfaded, hatched \\: not predictable (the panel says why)"
+    return f"{span}\n{marks}\nwhite: the gains now; black: the paper's"
 
 
 def _law_eq(view: GainView) -> str:

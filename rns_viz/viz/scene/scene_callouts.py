@@ -3,14 +3,14 @@ placed off both arms."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import viser
 
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.scene.callout_layout import PageCamera
-from rns_viz.viz.scene.callouts import page_camera
+from rns_viz.viz.scene.callouts import FixedText, page_camera
 from rns_viz.viz.scene.fsms_scene import FsmsScene
 from rns_viz.viz.scene.ghost import Ghost
 
@@ -28,11 +28,13 @@ class SceneCallouts:
         handle: viser.TransformControlsHandle | None,
         connections: Connections | None,
         notice: Callable[[int], bool] = lambda client_id: False,
+        texts: Callable[[], Sequence[FixedText]] = lambda: (),
     ) -> None:
         """``handle`` None: no "drag me"; ``connections`` None (a recording's export): no pages, so every
-        label is drawn at its point; ``notice(client_id)``: the page's panel shows the slowed-display line."""
+        label is drawn at its point; ``notice(client_id)``: the page's panel shows the slowed-display line;
+        ``texts()``: the other labels written in the scene (the gain map's title and legend)."""
         self.server, self.scene, self.ghost, self.handle, self.connections = server, scene, ghost, handle, connections
-        self.notice = notice
+        self.notice, self.texts = notice, texts
         self.callouts = scene.callouts  # the base's callout is the scene's own
         self.drag = None
         if handle is not None:  # its frame: the handle's parent (FsmsScene.BASE_AT_REST), its point: the handle
@@ -54,7 +56,7 @@ class SceneCallouts:
         if self.ghost_name.shown:
             hand = self.ghost.robot.data.oMi[self.hand_joint]
             self.ghost_name.attach(hand.rotation, hand.translation, self.hand_point)
-        self.callouts.frame(now, self.pages, self.solids, labels_on)
+        self.callouts.frame(now, self.pages, self.solids, labels_on, self.texts)
 
     def pages(self) -> list[PageCamera]:
         """The pages' cameras, the operator's first (then by connection order)."""

@@ -36,7 +36,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "gain_map",
         "Gain map (which gains damp fastest)",
         False,
-        "A map of (g_b, g_m) settings coloured by how fast the base's swing dies out, left of the robot; click a "
+        "A map of (g_b, g_m) settings coloured by how fast the base's swing dies out, above the robot; click a "
         "cell to apply its gains. The Gain explorer folder explains it.",
     ),
     (

@@ -122,7 +122,13 @@ class Renderer:
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
             self.view.boxes["rank"].visible = has_rank_inset(self.model)
         self.callouts = SceneCallouts(
-            self.server, self.scene, self.teach.ghost, self.handle, self.connections, lambda cid: self.page_notice(cid)
+            self.server,
+            self.scene,
+            self.teach.ghost,
+            self.handle,
+            self.connections,
+            lambda cid: self.page_notice(cid),
+            lambda: self.explorer.scene.texts() if self.explorer.scene is not None else [],
         )
         self.scene.set_target(snap.target)
         self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
