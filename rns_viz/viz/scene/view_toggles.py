@@ -99,10 +99,12 @@ class ViewToggles:
 
     def on(self, name: str) -> bool:
         box = self.boxes.get(name)
-        return True if box is None else box.value is True
+        return True if box is None else box.value is True and not box.disabled
 
     def show(self, name: str, on: bool = True) -> None:
-        """Tick or untick one toggle, as the server (the map for a gain lesson, a test)."""
+        """Tick or untick one toggle, as the server (the map for a gain lesson, a test); a toggle disabled for
+        the model stays unticked."""
+        on = on and not (name in self.boxes and self.boxes[name].disabled)
         self.good[name] = on
         if name in self.boxes and self.boxes[name].value != on:
             self.boxes[name].value = on
@@ -111,9 +113,49 @@ class ViewToggles:
         """Tick exactly ``names`` (a lesson's view), as the server: no refusal, no callback work."""
         wanted = set(names)
         for name, box in self.boxes.items():
-            self.good[name] = name in wanted
+            self.good[name] = name in wanted and not box.disabled
             if box.value != self.good[name]:
                 box.value = self.good[name]
+
+    def fit(self, model: FsmsModel) -> None:
+        """Disable (and untick) the toggles that draw nothing on ``model``, their hints saying why; enable the rest."""
+        why = nothing_to_show(model)
+        hints = {name: hint for name, _, _, hint in TOGGLES}
+        for name, box in self.boxes.items():
+            box.disabled = name in why
+            box.hint = f"{why[name]} {hints[name]}" if name in why else hints[name]
+            if name in why:
+                self.show(name, False)
+
+
+def nothing_to_show(model: FsmsModel) -> dict[str, str]:
+    """The toggles that cannot show anything on ``model``, each with the reason in plain words: the path
+    overlays need a single reactionless path (a 1-D reaction null space, Sec. III), the reachable region a
+    larger one, and the gain map a model whose gains the explorer analyses (not a compensating arm's)."""
+    kind = operator_class(model)
+    if kind.compensates:
+        no_path = "Not for this model: a second arm cancels the task arm's reaction, so no reactionless path is traced."
+    else:
+        no_path = (
+            "Not for this model: its reaction null space has two or more dimensions, so there is no single "
+            "reactionless path (the reachable region shows where the hand can go instead)."
+        )
+    why: dict[str, str] = {}
+    if kind.shows != "path":
+        why |= dict.fromkeys(("paths", "null_vector", "path_arrows"), no_path)
+    if kind.shows != "reachable set":
+        why["reach"] = (
+            "Not for this model: a second arm cancels the task arm's reaction, so the hand goes anywhere it reaches."
+            if kind.compensates
+            else "Not for this model: its reaction null space is one-dimensional, so the hand moves only along "
+            "its reactionless path."
+        )
+    if kind.compensates:
+        why["gain_map"] = (
+            "Not for this model: the gain map is computed for one arm damping the base's swing, not for a second "
+            "arm that cancels the reaction."
+        )
+    return why
 
 
 def first_look(model: FsmsModel) -> frozenset[str]:
@@ -140,7 +182,7 @@ def make_view_toggles(gui: viser.GuiApi, connections: Connections, shown: Iterab
         def _(event: viser.GuiEvent) -> None:
             if box.value == good[name]:
                 return
-            if isinstance(box.value, bool) and connections.allowed(event.client):
+            if isinstance(box.value, bool) and not box.disabled and connections.allowed(event.client):
                 good[name] = box.value
                 return
             if not connections.allowed(event.client):

@@ -120,6 +120,7 @@ class Renderer:
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
             self.view.boxes["rank"].visible = has_rank_inset(self.model)
+        self.view.fit(self.model)  # toggles with nothing to draw on this model are disabled, saying why
         self.callouts = SceneCallouts(self.server, self.scene, self.teach.ghost, self.handle, self.connections)
         self.scene.set_target(snap.target)
         self.explorer.build_scene(self.scene.style, self.kind.shows == "path")
