@@ -31,6 +31,7 @@ from rns_viz.viz.scene.framing import (
     framed_points,
     is_narrow,
 )
+from rns_viz.viz.scene.quantities import BASE_VIBRATION
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.scene.shapes import Trail, path_colours, path_family_segments, polyline_segments
@@ -363,7 +364,7 @@ class FsmsScene:
 
 def base_label(exaggeration: float) -> str:
     """The base's label: what it is, and how much larger than simulated its deflection is drawn."""
-    return f"base vibration x_b (drawn ×{exaggeration:g})"
+    return f"{BASE_VIBRATION.name} (drawn ×{exaggeration:g})"
 
 
 def _make_base_drawing(

@@ -16,6 +16,7 @@ from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.teaching.rank_view import RANK_HINT
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.scene.quantities import MOMENTUM, REACTION
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
 TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
@@ -48,16 +49,16 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
     ),
     (
         "reaction",
-        "Reaction force on the base (N)",
+        f"{REACTION.name.capitalize()} ({REACTION.unit})",
         True,
-        "Red arrow: the force the arm's motion puts on the base, −(H_bm θ'' + c_b) of Eq. (1), in newtons.",
+        "Red arrow: the force the arm's motion puts on the base, −(H_bm θ'' + c_b) of Eq. (1), in newtons (N).",
     ),
     (
         "coupling",
-        "Momentum handed to the base L (kg·m/s)",
+        f"{MOMENTUM.name.capitalize()} ({MOMENTUM.unit})",
         True,
-        "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8). "
-        "Zero on a reactionless path.",
+        "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8), in N·s "
+        "(1 N·s = 1 kg·m/s). Zero on a reactionless path.",
     ),
     (
         "null_vector",
