@@ -7,6 +7,7 @@ its parenthesis: *Live plots* for the tab 'Live plots (last 10 s)')."""
 from __future__ import annotations
 
 import ast
+import colorsys
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -25,8 +26,20 @@ from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
 from rns_viz.viz.panels import lesson_panel, live_plots
 from rns_viz.viz.panels.glossary import GLOSSARY
 from rns_viz.viz.panels.live_plots import E_TITLE, L_TITLE, XB_TITLE
-from rns_viz.viz.scene.fsms_scene import base_label
+from rns_viz.viz.scene.fsms_scene import (
+    FORCE_COLOUR,
+    PATH_COLOUR,
+    PATH_HIGHLIGHT,
+    REACH_COLOUR,
+    TARGET_COLOUR,
+    TRAIL_COLOUR,
+    base_label,
+)
+from rns_viz.viz.scene.ghost import GHOST_COLOUR
 from rns_viz.viz.scene.quantities import BASE_VIBRATION, HAND_MISS, MOMENTUM, QUANTITIES, REACTION, Quantity
+from rns_viz.viz.scene.rank_scene import RANK_COLOUR
+from rns_viz.viz.scene.reaction_arrows import MOMENT_COLOUR
+from rns_viz.viz.scene.teach_scene import L_COLOUR, N_COLOUR
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import wait_until
 
@@ -257,3 +270,115 @@ def test_the_readouts_name_each_quantity_as_everywhere_else(model: str) -> None:
         ]
         assert {q for name, _ in rows for q in named(name)} == set(QUANTITIES)
         assert not errors, "\n".join(errors)
+
+
+COLOUR = r"(red|crimson|magenta|pink|purple|violet|lilac|blue|green|orange|amber|yellow|grey|gray)"
+# Hue ranges (degrees, start to end going up through 360) each colour word may name; lilac is a pale purple.
+HUES = {
+    "red": (345, 15),
+    "crimson": (330, 355),
+    "magenta": (290, 335),
+    "pink": (300, 355),
+    "purple": (255, 300),
+    "violet": (255, 300),
+    "lilac": (240, 290),
+    "blue": (195, 250),
+    "green": (80, 165),
+    "orange": (18, 45),
+    "amber": (30, 50),
+    "yellow": (45, 70),
+}
+
+
+def names_colour(word: str, rgb: tuple[float, ...]) -> bool:
+    """Whether a person would call ``rgb`` (0-1 or 0-255) ``word``: grey is unsaturated, the rest a hue range."""
+    scale = 255.0 if max(rgb) > 1.0 else 1.0
+    hue, saturation, value = colorsys.rgb_to_hsv(*(c / scale for c in rgb))
+    if word in ("grey", "gray"):
+        return saturation < 0.15
+    if word == "lilac" and not (0.1 < saturation < 0.45 and value > 0.75):
+        return False
+    if saturation < 0.15 and word != "lilac":
+        return False
+    lo, hi = HUES[word]
+    degrees = 360.0 * hue
+    return lo <= degrees <= hi if lo < hi else degrees >= lo or degrees <= hi
+
+
+def test_the_hue_names_are_those_a_person_would_use() -> None:
+    assert (
+        names_colour("red", (255, 0, 0)) and names_colour("red", (180, 0, 0)) and not names_colour("red", (0, 0, 255))
+    )
+    assert names_colour("crimson", (0.90, 0.05, 0.30)) and not names_colour("red", (0.90, 0.05, 0.30))
+    assert names_colour("grey", (128, 128, 128)) and not names_colour("grey", (0.62, 0.74, 0.88))
+    assert names_colour("lilac", (196, 182, 236)) and not names_colour("lilac", (120, 40, 170))
+
+
+# Each scene object, the colour it is drawn in and how the app's texts write its colour (one group: the word).
+SCENE_COLOURS: dict[str, tuple[tuple[float, ...], tuple[str, ...]]] = {
+    "current path": (
+        PATH_HIGHLIGHT,
+        (
+            rf"\b{COLOUR} (?:reactionless )?(?:path|curve)\b",
+            rf"(?:current one|reactionless path|current path) \({COLOUR}\b",
+            rf"current path is always drawn in {COLOUR}",
+        ),
+    ),
+    "other paths": (PATH_COLOUR, (rf"paths \({COLOUR}\)", rf"the {COLOUR} family")),
+    "reaction force": (
+        FORCE_COLOUR,
+        (
+            rf"{COLOUR} arrow: (?:the force|−)",
+            rf"{COLOUR} arrow is the",
+            rf"base \({COLOUR} arrow, −",
+            rf"{COLOUR} force arrow",
+        ),
+    ),
+    "reaction moment": (MOMENT_COLOUR, (rf"{COLOUR} moment arrow",)),
+    "momentum L": (
+        L_COLOUR,
+        (rf"{COLOUR} arrow: the momentum", rf"\({COLOUR} arrow\), Eq\. \(8\)", rf"θ' \({COLOUR},"),
+    ),
+    "reaction-free direction n": (
+        N_COLOUR,
+        (rf"{COLOUR} arrow at the hand", rf"\({COLOUR} arrow: the hand", rf"produces \({COLOUR}"),
+    ),
+    "trail": (TRAIL_COLOUR, (rf"{COLOUR} line: where the hand",)),
+    "reachable set": (REACH_COLOUR, (rf"(?<!-){COLOUR} dots",)),
+    "rank-loss poses": (
+        RANK_COLOUR,
+        (rf"{COLOUR} (?:poses|links)", rf"(?:poses|configurations) (?:drawn )?in {COLOUR}"),
+    ),
+    "ghost": (GHOST_COLOUR, (rf"{COLOUR} ghost", rf"see-through \({COLOUR}\)", rf"see-through {COLOUR}")),
+    "target": (TARGET_COLOUR, (rf"{COLOUR} target marker",)),
+}
+# A colour word right before one of these (or in brackets after it) is about a scene object: the table above
+# must know every such phrase (not a colour map's ends, as in 'yellow-to-purple dots').
+ABOUT_THE_SCENE = re.compile(
+    rf"(?<![-\w]){COLOUR} (?:\w+ )?(?:arrow|path|curve|dots|poses|links|ghost|family|marker)s?\b", re.I
+)
+
+
+def test_every_colour_word_about_a_scene_object_names_the_colour_it_is_drawn_in() -> None:
+    """The current path is drawn crimson, not red (red is the reaction arrow, and 'suppression off' in the
+    plots), the path family grey, the ghost blue...: every phrase of the panel, Help, lessons and docs that
+    gives a scene object's colour names its hue."""
+    texts = list(shown_strings())
+    wrong, counted, seen = [], dict.fromkeys(SCENE_COLOURS, 0), set()
+    for obj, (rgb, patterns) in SCENE_COLOURS.items():
+        for where, text in texts:
+            for pattern in patterns:
+                for m in re.finditer(pattern, text, re.I):
+                    counted[obj] += 1
+                    seen.add((where, m.start(1)))
+                    if not names_colour(m[1].lower(), rgb):
+                        wrong.append(f"{where}: {obj} said {m[1]!r} in {text[max(0, m.start() - 30) : m.end() + 10]!r}")
+    assert all(counted.values()), f"phrases the table no longer finds: {[o for o, n in counted.items() if not n]}"
+    unknown = [
+        f"{where}: {m[0]!r}"
+        for where, text in texts
+        for m in ABOUT_THE_SCENE.finditer(text)
+        if (where, m.start(1)) not in seen
+    ]
+    assert not unknown, f"colour words about the scene the table does not know: {unknown}"
+    assert not wrong, "\n".join(wrong)

@@ -46,7 +46,7 @@ GLOSSARY: tuple[tuple[str, str, str, str], ...] = (
         "how fast the joints move along n, in 1/(kg·m·s); ∫ū dt is the position along the path, 1/(kg·m)",
         "Eq. (30)",
     ),
-    ("reactionless path", "—", "a joint motion that never pushes the base: the red curve", "Sec. V"),
+    ("reactionless path", "—", "a joint motion that never pushes the base: the crimson curve", "Sec. V"),
     (
         "hand Jacobian in the null space",
         "J̄",

@@ -30,7 +30,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "paths",
         "Other reactionless paths (grey)",
         False,
-        "The family of reactionless paths around the current one (red, always drawn): every way the hand can "
+        "The family of reactionless paths around the current one (crimson, always drawn): every way the hand can "
         "move without pushing the base, from other start poses.",
     ),
     (
@@ -72,7 +72,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "path_arrows",
         "Path direction arrows",
         True,
-        "Arrowheads on the red reactionless path pointing the way the arm moves when ū is positive.",
+        "Arrowheads on the crimson reactionless path pointing the way the arm moves when ū is positive.",
     ),
     (
         "reach",
