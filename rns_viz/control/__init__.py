@@ -1,7 +1,7 @@
 """The paper's control laws, one module each, one call signature: law(t, q, v) -> ControlOutput."""
 
 from rns_viz.control.acceleration import AccelerationLaw, composite_acceleration
-from rns_viz.control.common import ControlLaw, ControlOutput, Gains, InvalidGain, LawKind
+from rns_viz.control.common import ControlLaw, ControlOutput, GainOutOfRange, Gains, InvalidGain, LawKind
 from rns_viz.control.hold import JointServo, Switched
 from rns_viz.control.null_input import (
     DampNullMotion,
@@ -26,6 +26,7 @@ __all__ = [
     "ControlOutput",
     "DampNullMotion",
     "FixedReference",
+    "GainOutOfRange",
     "Gains",
     "InvalidGain",
     "JointQuintic",

@@ -15,6 +15,7 @@ import numpy as np
 
 from rns_viz.lapack import solve
 from rns_viz.model import FsmsModel
+from rns_viz.out_of_range import OutOfRange, check_range
 
 if TYPE_CHECKING:
     from rns_viz.control.reference import ReferenceSample
@@ -31,10 +32,23 @@ LawKind = Literal["acceleration", "torque", "velocity", "servo"]
 
 
 MAX_GAIN = 1e6  # any gain, in its units: far beyond every stable setting of the bundled models
+GAIN_UNITS = {
+    "g_b": "1/s",
+    "g_m": "1/s",
+    "G_p": "1/s²",
+    "G_d": "1/s",
+    "k_p": "1/s²",
+    "k_d": "1/s",
+    "servo_bandwidth": "rad/s",
+}
 
 
 class InvalidGain(ValueError):
     """A gain that is not a finite number in its allowed range."""
+
+
+class GainOutOfRange(InvalidGain, OutOfRange):
+    """A gain that is a number, but not a finite one from 0 to MAX_GAIN (its range and unit attached)."""
 
 
 @dataclass(frozen=True)
@@ -52,10 +66,10 @@ class Gains:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if not isinstance(value, int | float) or isinstance(value, bool) or not math.isfinite(value):
-                raise InvalidGain(f"gain {f.name} must be a finite number, got {value!r}")
-            if not 0 <= value <= MAX_GAIN:  # (larger is beyond any stable setting)
-                raise InvalidGain(f"gain {f.name} must be from 0 to {MAX_GAIN:g}, got {value:g}")
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise InvalidGain(f"gain {f.name} must be a number, got {value!r}")
+            # (larger than MAX_GAIN is beyond any stable setting)
+            check_range(f"gain {f.name}", value, 0.0, MAX_GAIN, GAIN_UNITS[f.name], error=GainOutOfRange)
         if self.servo_bandwidth <= 0:
             raise InvalidGain("servo_bandwidth must be positive")
 

@@ -79,3 +79,10 @@ def test_rank_overlay_toggle_draws_the_rank_deficient_poses() -> None:
         assert rank.overlay is not None and len(rank.overlay.poses) == 4
     finally:
         app.stop()
+
+
+def test_the_gain_explorer_offers_nothing_it_does_not_compute(trep2_app: RnsApp) -> None:
+    """A compensating arm's loop is not analysed: no empty root-locus charts, no quantity to choose for a map."""
+    ex = trep2_app.renderer.explorer
+    wait_until(lambda: not ex.locus_b.visible and not ex.locus_m.visible, 10.0, "the loci hidden")
+    assert not ex.locus_note.visible and ex.quantity.disabled and ex.quantity.hint.startswith("Not for this model")

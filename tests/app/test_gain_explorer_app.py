@@ -290,3 +290,9 @@ def test_after_a_model_switch_the_new_models_map_is_drawn() -> None:
         assert explorer(app).scene.authority.visible and not explorer(app).scene.authority_lines.visible
     finally:
         app.stop()
+
+
+def test_the_root_loci_and_the_map_quantity_are_offered_where_computed(trep_app: RnsApp) -> None:
+    ex = trep_app.renderer.explorer
+    wait_until(lambda: ex.locus_b.visible and ex.locus_m.visible, 10.0, "the loci shown")
+    assert ex.locus_note.visible and not ex.quantity.disabled

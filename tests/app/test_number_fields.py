@@ -12,6 +12,7 @@ from dataclasses import fields
 import pytest
 
 from rns_viz.live.loop.commands import Scrub
+from rns_viz.out_of_range import OutOfRange, readable, split_label
 from rns_viz.viz.panels import number_field
 from rns_viz.viz.panels.input_check import is_unfinished_number, parse_number
 from rns_viz.viz.panels.number_field import NumberField, shown
@@ -89,9 +90,11 @@ def test_a_typed_number_is_applied_exactly_or_refused_with_a_message(
         if field in replay_only:
             continue
         old = app.controls.good(field)
-        for text, words in (("1e9", "1e+09"), ("NaN", "finite"), ("abc", "is not a number"), ("1,5", "not a number")):
+        name = split_label(field.label)[0]
+        for text, words in (("1e9", "10⁹"), ("NaN", "finite"), ("abc", "is not a number"), ("1,5", "not a number")):
             message = type_into(app, client, told, field, text)
             assert message is not None and words in message, (field.label, text, message)
+            assert message.startswith(name) and "e+" not in message, (field.label, text, message)  # as labelled
             assert app.controls.good(field) == old and field.value == old, (field.label, text)
         # A number in the field's range, typed in exponent form: applied as typed, shown plainly.
         lo, hi = field.min, field.max
@@ -114,15 +117,44 @@ def test_a_typed_number_is_applied_exactly_or_refused_with_a_message(
     assert settings.ubar_speed == app.controls.good(app.gui.ubar_speed)
 
 
-def test_out_of_range_numbers_are_refused_with_the_range(typing_app: tuple[RnsApp, ProtocolClient, Told]) -> None:
+G = "\u202f"  # the narrow no-break space between digit groups
+
+
+def test_out_of_range_numbers_are_refused_naming_the_control_its_unit_and_the_range(
+    typing_app: tuple[RnsApp, ProtocolClient, Told],
+) -> None:
+    """The gains' range is checked by Gains (once); the panel words its refusal with the box's label and unit,
+    numbers as people write them (it said "gain g_b must be from 0 to 1e+06, got 1e+09")."""
     app, client, told = typing_app
     g = app.gui
-    assert "from 0 to 1e+06, got 1e+09" in (type_into(app, client, told, g.gains["g_b"], "1e9") or "")
-    assert "got 1e+12" in (type_into(app, client, told, g.gains["g_m"], "1e12") or "")
+    assert g.gains["g_b"].label == "Base damping g_b (1/s)"
+    for text, said in (
+        ("1e9", "10⁹"),
+        ("-5", "−5"),
+        ("NaN", "NaN"),
+    ):
+        finite = "a finite number " if text == "NaN" else ""
+        expected = f"Base damping g_b must be {finite}from 0 to 1{G}000{G}000 1/s, not {said}"
+        assert type_into(app, client, told, g.gains["g_b"], text) == expected
+    message = type_into(app, client, told, g.gains["g_m"], "1e12")
+    assert message == f"{split_label(g.gains['g_m'].label)[0]} must be from 0 to 1{G}000{G}000 1/s, not 10¹²"
     lo, hi = g.kick_peak.min, g.kick_peak.max
-    message = type_into(app, client, told, g.kick_peak, "1e9") or ""
-    assert f"[{lo:g}, {hi:g}]" in message and "1e+09" in message, message
-    assert "up to 10000" in (type_into(app, client, told, g.ubar_speed, "-1") or "")
+    message = type_into(app, client, told, g.kick_peak, "1e9")
+    assert message == f"Kick strength, peak force must be from −{-lo:g} to {hi:g} N, not 10⁹"
+    message = type_into(app, client, told, g.ubar_speed, "-1")
+    assert message == f"Speed along the path ū must be above 0 and at most 10{G}000 1/(kg·m·s), not −1"
+
+
+def test_numbers_are_written_for_people() -> None:
+    cases = {1e6: f"1{G}000{G}000", 1e9: "10⁹", -5.0: "−5", 0.25: "0.25", 1e4: f"10{G}000", 1234.5: "1234.5"}
+    cases |= {2.5e-7: "2.5 × 10⁻⁷", 1.5e9: "1.5 × 10⁹", 0.001: "0.001", 0.0: "0", math.inf: "∞", math.nan: "NaN"}
+    for value, text in cases.items():
+        assert readable(value) == text, value
+    assert split_label("Position along the path ∫ū dt (1/(kg·m))") == ("Position along the path ∫ū dt", "1/(kg·m)")
+    assert split_label("Base deflection drawn ×") == ("Base deflection drawn ×", "")
+    assert OutOfRange("replay speed", 9.0, 0.1, 4.0, "×").for_control("Replay speed (×)") == (
+        "Replay speed must be from 0.1× to 4×, not 9"
+    )
 
 
 def test_typed_replay_speed_and_time(typing_app: tuple[RnsApp, ProtocolClient, Told]) -> None:
@@ -133,7 +165,7 @@ def test_typed_replay_speed_and_time(typing_app: tuple[RnsApp, ProtocolClient, T
     s.advance(0.0)
     replay = s.snapshot().replay
     assert replay is not None
-    assert "from 0.1x to 4x, got 1e+09" in (type_into(app, client, told, app.replay.speed, "1e9") or "")
+    assert type_into(app, client, told, app.replay.speed, "1e9") == "Replay speed must be from 0.1× to 4×, not 10⁹"
     assert type_into(app, client, told, app.replay.speed, "2.5e0") is None
     s.advance(0.0)
     assert s.snapshot().replay.speed == 2.5  # type: ignore[union-attr]
@@ -196,7 +228,7 @@ def test_text_is_read_when_the_typing_pauses_not_per_keystroke(
         client.set_value(gui_uuid(g_b.box), text)
     wait_until(lambda: len(told) > before and not g_b.typing(), 10.0, "the typed text to be read")
     assert applied == [1e9] and app.controls.good(g_b) == old
-    assert [body for _, body in told[before:]] == ["gain g_b must be from 0 to 1e+06, got 1e+09"]
+    assert [body for _, body in told[before:]] == [f"Base damping g_b must be from 0 to 1{G}000{G}000 1/s, not 10⁹"]
 
 
 def test_parse_number_reads_numbers_only() -> None:

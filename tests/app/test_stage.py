@@ -158,6 +158,35 @@ def check_first_look_and_toggles(app: RnsApp, model: str) -> None:
     wait_until(lambda: not explorer.scene.frame.visible, 5.0, "the map hidden again")
 
 
+def test_toggles_that_draw_nothing_on_a_model_are_disabled_saying_why_and_come_back_on_switching(
+    trep_app: RnsApp,
+) -> None:
+    """planar3r has no single reactionless path (a 2-D null space) and trep2 neither a path nor a gain map (a
+    second arm compensates): their path toggles (and trep2's map) are disabled, unticked, a tick refused, the
+    hint saying why; the region of a larger null space is disabled on the path models. Back on trep all
+    path toggles work again."""
+    app, s = trep_app, trep_app.session
+    no_path = {"paths", "null_vector", "path_arrows"}
+    expected = {"trep": {"reach"}, "planar3r": no_path, "trep2": no_path | {"reach", "gain_map"}, "boom7": {"reach"}}
+    hints = {name: hint for name, _, _, hint in TOGGLES}
+    for model in ("trep", "planar3r", "trep2", "trep"):
+        if model != app.model_name:
+            s.switch_model(model)
+            settle(app)
+            wait_until(lambda model=model: app.model_name == model, 30.0, f"the scene of {model}")
+        disabled = {name for name, box in app.view.boxes.items() if box.disabled}
+        assert disabled == expected[model], model
+        for name, box in app.view.boxes.items():
+            if name in disabled:
+                assert not box.value and box.hint.startswith("Not for this model: "), (model, name)
+                app.view.show(name)
+                assert not box.value and not app.view.on(name)
+            else:
+                assert box.hint == hints[name], (model, name)
+    app.view.show("path_arrows")
+    assert app.view.on("path_arrows")
+
+
 def test_labels_keep_off_the_gain_map_while_it_is_shown(trep_app: RnsApp) -> None:
     """The map, its title, ticks and legend are one solid of the callouts' layout while shown (no label
     covers a cell of it; the layout keeps labels off every solid: tests/unit/test_callouts.py), none hidden."""

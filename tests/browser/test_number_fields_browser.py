@@ -63,9 +63,10 @@ def test_typed_gains_are_applied_exactly_or_refused_with_a_message(app: RnsApp) 
         box = box_of(page, "Base damping g_b (1/s)")
         box.scroll_into_view_if_needed()
         for text, message in (
-            ("1e9", "gain g_b must be from 0 to 1e+06, got 1e+09"),
-            ("NaN", "gain g_b must be a finite number, got nan"),
-            ("abc", "Base damping g_b (1/s): 'abc' is not a number"),
+            ("1e9", "Base damping g_b must be from 0 to 1\u202f000\u202f000 1/s, not 10⁹"),
+            ("NaN", "Base damping g_b must be a finite number from 0 to 1\u202f000\u202f000 1/s, not NaN"),
+            ("-5", "Base damping g_b must be from 0 to 1\u202f000\u202f000 1/s, not −5"),
+            ("abc", "Base damping g_b: 'abc' is not a number"),
         ):
             old = gains().g_b
             dismiss_notifications(page)

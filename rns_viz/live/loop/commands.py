@@ -17,10 +17,11 @@ from typing import Any, get_args
 
 import numpy as np
 
-from rns_viz.control import Gains, InvalidGain, LawKind
+from rns_viz.control import GainOutOfRange, Gains, InvalidGain, LawKind
 from rns_viz.live.loop.wall_clock import SPEEDS
 from rns_viz.live.outputs.recorder import MAX_RECORD_S
 from rns_viz.live.teaching.lessons import lessons_for, models_with_lessons
+from rns_viz.out_of_range import check_range
 from rns_viz.param_file import LawName
 from rns_viz.params import check_model_key, missing_extra
 from rns_viz.scenarios import LIVE_SCENARIOS
@@ -158,10 +159,7 @@ class SetUbarSpeed(Command):
     value: float  # 1/(kg m s): u-bar when scrubbing, dragging and in cyclic motion (1-D RNS)
 
     def __post_init__(self) -> None:
-        if not 0 < _finite("u-bar speed", self.value) <= MAX_UBAR_SPEED:
-            raise InvalidGain(
-                f"u-bar speed must be a positive number up to {MAX_UBAR_SPEED:g} 1/(kg m s), got {self.value:g}"
-            )
+        check_range("u-bar speed", self.value, 0.0, MAX_UBAR_SPEED, "1/(kg·m·s)", low_open=True, error=GainOutOfRange)
 
 
 @dataclass(frozen=True)
@@ -169,10 +167,7 @@ class SetTargetSpeed(Command):
     value: float  # m/s: speed limit of the smoothed target (multi-dimensional RNS)
 
     def __post_init__(self) -> None:
-        if not 0 < _finite("target speed", self.value) <= MAX_TARGET_SPEED:
-            raise InvalidGain(
-                f"target speed must be a positive number of m/s up to {MAX_TARGET_SPEED:g}, got {self.value:g}"
-            )
+        check_range("target speed", self.value, 0.0, MAX_TARGET_SPEED, "m/s", low_open=True, error=GainOutOfRange)
 
 
 @dataclass(frozen=True)
@@ -331,9 +326,7 @@ class SetReplaySpeed(ReplayCommand):
     speed: float  # recorded seconds per wall second
 
     def __post_init__(self) -> None:
-        lo, hi = REPLAY_SPEEDS
-        if not lo <= _finite("replay speed", self.speed) <= hi:
-            raise ValueError(f"replay speed must be from {lo:g}x to {hi:g}x, got {self.speed:g}")
+        check_range("replay speed", self.speed, *REPLAY_SPEEDS, "×")
 
 
 @dataclass(frozen=True)

@@ -132,7 +132,7 @@ class Outputs:
                 self._warned_step = self.steps
                 self.warn(
                     "Reaction not cancelled",
-                    f"{cancel[0].upper()}{cancel[1:]}; the red arrow is the residual reaction.",
+                    f"{cancel[0].upper()}{cancel[1:]}; the red arrow is the reaction on the base F_b both arms leave.",
                 )
             readouts = replace(readouts, cancel=cancel, compensating=compensating)
         self.readouts = readouts

@@ -252,7 +252,7 @@ def _controls(gui: viser.GuiApi, model: str, menu: ModelMenu) -> dict[str, Any]:
     with gui.add_folder("Reactionless path") as path_folder:
         gui.add_markdown(
             "Drag the handle labelled **drag me** in the scene: the end effector moves along its current "
-            "reactionless path (red) to the point nearest the handle. Or scrub the path position."
+            "reactionless path (crimson) to the point nearest the handle. Or scrub the path position."
         )
         sigma = NumberField(
             gui,

@@ -38,6 +38,14 @@ BASE_COLOUR, ARM_COLOUR, NOW_COLOUR = "#e0503a", "#1f6fd1", "#111111"
 CHECK_S = 0.1  # s: the view is checked at 10 Hz (its changes come in bursts: gains, poles, authority)
 _SLIDER_MAX = {name: hi for name, _, _, hi, _, _ in GAIN_SLIDERS}
 _G_M_HINT = next(h for name, *_, h in GAIN_SLIDERS if name == "g_m")
+_QUANTITY_HINT = (
+    "Base: how a kick decays, σ_b = ln 10 / the time it takes to fall to 10 % of its peak; arm mode: the slowest "
+    "pole a kick hardly shows (Sec. VIII: two subsystems)."
+)
+_NOT_ANALYSED = (
+    "Not for this model: the gain map is computed for one arm damping the base's swing, not for a second arm "
+    "that cancels the reaction."
+)
 
 
 def _locus_plot(gui: viser.GuiApi, title: str) -> viser.GuiUplotHandle:
@@ -100,15 +108,14 @@ class GainExplorerView:
                 "Map shows",
                 tuple(QUANTITIES),
                 initial_value=next(iter(QUANTITIES)),
-                hint="Base: how a kick decays, σ_b = ln 10 / the time it takes to fall to 10 % of its peak; arm "
-                "mode: the slowest pole a kick hardly shows (Sec. VIII: two subsystems).",
+                hint=_QUANTITY_HINT,
             )
             self.meaning = g.add_markdown("")
             self.predicted = g.add_markdown("")
             self.authority = g.add_markdown("")
             self.locus_b = _locus_plot(g, "Root locus, g_b sweeps")
             self.locus_m = _locus_plot(g, "Root locus, g_m sweeps")
-            g.add_markdown(
+            self.locus_note = g.add_markdown(
                 "Closed-loop poles λ (1/s); further left decays faster. Fast poles off the left edge are not shown."
             )
         controls.on_input(self.quantity, lambda v, c: None)  # read below; watchers are refused and reverted
@@ -197,9 +204,12 @@ class GainExplorerView:
             self._loci_of = (view.model, view.law)
             for plot in (self.locus_b, self.locus_m):
                 plot.data = tuple(np.zeros(2) for _ in range(4))
-                plot.title = (
-                    "Root locus: being computed…" if view.analysed else "Root locus: not computed for this model"
-                )
+                plot.title = "Root locus: being computed…"
+            # a compensating arm's loop is not analysed: no loci, and no map to choose a quantity of
+            for handle in (self.locus_b, self.locus_m, self.locus_note):
+                handle.visible = view.analysed
+            self.quantity.disabled = not view.analysed
+            self.quantity.hint = _QUANTITY_HINT if view.analysed else _NOT_ANALYSED
         for plot, locus, other in ((self.locus_b, view.locus_g_b, "g_m"), (self.locus_m, view.locus_g_m, "g_b")):
             if locus is None:
                 continue

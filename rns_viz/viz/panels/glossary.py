@@ -3,15 +3,35 @@ the keys. Plain words first, the symbol second, as everywhere in the app."""
 
 from __future__ import annotations
 
+from rns_viz.viz.scene.quantities import BASE_VIBRATION, HAND_MISS, MOMENTUM, REACTION
+
 # (plain words, symbol, what it is, where in the paper)
 GLOSSARY: tuple[tuple[str, str, str, str], ...] = (
-    ("base vibration", "x_b", "how far the flexible base (beam, cart, boom tip) is bent from rest, m", "Eq. (1)"),
-    ("arm's push on the base", "F_b", "the force the arm's motion puts on the base, N", "Eq. (1)"),
     (
-        "momentum handed to the base",
-        "L = H_bm θ'",
-        "the coupling momentum: what the joints' motion gives the base, N·s; zero on a reactionless path",
+        BASE_VIBRATION.words,
+        BASE_VIBRATION.symbol,
+        f"how far the flexible base (beam, cart, boom tip) is bent from rest, {BASE_VIBRATION.unit}",
+        "Eq. (1)",
+    ),
+    (
+        REACTION.words,
+        REACTION.symbol,
+        f"the force the arm's motion puts on the base, −(H_bm θ'' + c_b), {REACTION.unit}; with a compensating "
+        "arm, what both arms leave on it",
+        "Eq. (1)",
+    ),
+    (
+        MOMENTUM.words,
+        f"{MOMENTUM.symbol} = H_bm θ'",
+        f"the coupling momentum: what the joints' motion gives the base, {MOMENTUM.unit} (1 N·s = 1 kg·m/s); "
+        "zero on a reactionless path",
         "Eq. (8)",
+    ),
+    (
+        HAND_MISS.words,
+        HAND_MISS.symbol,
+        f"how far the hand is from where the control law (or the dragged target) sends it, {HAND_MISS.unit}",
+        "",
     ),
     ("coupling inertia", "H_bm", "how the joints' motion couples into the base (a matrix)", "Eq. (1)"),
     (
@@ -26,7 +46,7 @@ GLOSSARY: tuple[tuple[str, str, str, str], ...] = (
         "how fast the joints move along n, in 1/(kg·m·s); ∫ū dt is the position along the path, 1/(kg·m)",
         "Eq. (30)",
     ),
-    ("reactionless path", "—", "a joint motion that never pushes the base: the red curve", "Sec. V"),
+    ("reactionless path", "—", "a joint motion that never pushes the base: the crimson curve", "Sec. V"),
     (
         "hand Jacobian in the null space",
         "J̄",

@@ -15,26 +15,24 @@ from typing import Any
 
 import viser
 
+from rns_viz.out_of_range import OutOfRange, check_range, split_label
+
 RANGE_SLACK = 1e-9  # relative: a value this close outside a slider's range counts as inside
 
 
-def _number(label: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ValueError(f"{label}: expected a number, got {value!r}")
-    if not math.isfinite(value):
-        raise ValueError(f"{label}: {value} is not a finite number")
-    return float(value)
-
-
 def check_value(handle: Any, value: Any) -> None:
-    """Raise ValueError unless ``value`` is a valid value of the control ``handle``."""
+    """Raise ValueError unless ``value`` is a valid value of the control ``handle`` (OutOfRange for a number
+    that is not a finite one in a slider's range, worded with the slider's label)."""
     label = getattr(handle, "label", "input")
     if isinstance(handle, viser.GuiSliderHandle | viser.GuiNumberHandle):
-        x = _number(label, value)
-        lo, hi = handle.min, handle.max
-        slack = RANGE_SLACK * max(1.0, abs(lo or 0.0), abs(hi or 0.0))
-        if (lo is not None and x < lo - slack) or (hi is not None and x > hi + slack):
-            raise ValueError(f"{label}: {x:g} is outside the allowed range [{lo:g}, {hi:g}]")
+        lo = -math.inf if handle.min is None else handle.min
+        hi = math.inf if handle.max is None else handle.max
+        slack = RANGE_SLACK * max(1.0, *(abs(b) for b in (lo, hi) if math.isfinite(b)))
+        name, unit = split_label(label)
+        try:
+            check_range(name, value, lo - slack, hi + slack, unit)
+        except OutOfRange as exc:  # said with the slider's own range, not the slack's
+            raise OutOfRange(name, exc.value, lo, hi, unit) from None
     elif isinstance(handle, viser.GuiCheckboxHandle):
         if not isinstance(value, bool):
             raise ValueError(f"{label}: expected on or off, got {value!r}")

@@ -24,6 +24,7 @@ import viser
 
 from rns_viz.live.loop.session import Session
 from rns_viz.live.runs.laws import LAW_LABELS
+from rns_viz.out_of_range import OutOfRange, split_label
 from rns_viz.viz.clients.connections import Connections
 from rns_viz.viz.panels.control_panel import SPEED_LABELS, GuiElements
 from rns_viz.viz.panels.input_check import check_value, parse_number
@@ -139,7 +140,7 @@ class Controls:
                 self.connections.refuse_watcher(client)
             elif text.strip():  # (a cleared box: nothing was typed; it shows the value again)
                 try:
-                    value = parse_number(field.label, text)
+                    value = parse_number(split_label(field.label)[0], text)
                 except ValueError as exc:
                     self.connections.notify(client, "Input not applied", str(exc), "warning")
                 else:
@@ -165,7 +166,9 @@ class Controls:
             if keep:
                 self._good[id(handle)] = value
         except ValueError as exc:  # InvalidGain, InputRefused, values the widget cannot hold
-            notify(client, "Input not applied", str(exc), "warning")
+            # a number out of its range is said as the control names it: its label's words and unit
+            said = exc.for_control(handle.label) if isinstance(exc, OutOfRange) and hasattr(handle, "label") else exc
+            notify(client, "Input not applied", str(said), "warning")
             self._revert(handle)  # show the value still in force
         except Exception as exc:
             traceback.print_exc()

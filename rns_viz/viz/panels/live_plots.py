@@ -25,10 +25,11 @@ import viser
 import viser.uplot
 
 from rns_viz.viz.panels.units import si
+from rns_viz.viz.scene.quantities import BASE_VIBRATION, HAND_MISS, MOMENTUM
 
 ON_COLOUR, OFF_COLOUR, ERROR_COLOUR = "#1f6fd1", "#e0503a", "#2a9d4b"
 # chart titles: plain words first, the symbol of the axis second
-XB_TITLE, L_TITLE, E_TITLE = "Base vibration x_b", "Momentum handed to the base L", "Hand's miss: error |e|"
+XB_TITLE, L_TITLE, E_TITLE = (q.name[0].upper() + q.name[1:] for q in (BASE_VIBRATION, MOMENTUM, HAND_MISS))
 SCALES = {"linear": "linear, fits the data", "symlog": "symmetric log, fixed range"}
 # Display units of the linear charts (name, SI value): one chart per unit, the one shown suits the data.
 LENGTH_UNITS = (("nm", 1e-9), ("µm", 1e-6), ("mm", 1e-3), ("m", 1.0))
@@ -292,7 +293,11 @@ def _clean(x: np.ndarray) -> np.ndarray:
     return np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)
 
 
-_ROWS = (("xb", "base |x_b|", "m"), ("L", "momentum |L|", "N·s"), ("e", "hand miss |e|", "m"))
+_ROWS = (
+    ("xb", f"{BASE_VIBRATION.words} |{BASE_VIBRATION.symbol}|", BASE_VIBRATION.unit),
+    ("L", f"{MOMENTUM.words} |{MOMENTUM.symbol}|", MOMENTUM.unit),
+    ("e", HAND_MISS.name, HAND_MISS.unit),
+)
 _ROW_HINTS = {
     "xb": "largest bend of the base from rest in the last 10 s",
     "L": "largest momentum the joints handed to the base (1 N·s = 1 kg·m/s)",

@@ -11,6 +11,7 @@ from rns_viz.live.published.snapshot import Snapshot
 from rns_viz.params import key_selection
 from rns_viz.viz.panels.model_menu import label_of
 from rns_viz.viz.panels.units import si
+from rns_viz.viz.scene.quantities import BASE_VIBRATION, HAND_MISS, MOMENTUM, REACTION
 
 OK_COLOUR = "#1b7f3b"
 WARN_COLOUR = "#c77700"
@@ -110,14 +111,14 @@ def readouts_html(snap: Snapshot) -> str:
             "the joint direction that pushes the base not at all (orange arrow: the hand's way), Eq. (27)",
         ),
         (
-            "momentum handed to the base L = H<sub>bm</sub>θ̇",
+            f"{MOMENTUM.html_name} = H<sub>bm</sub>θ̇",
             si(r.L, "N·s", 1e-9, True),
             "momentum the joints hand to the base (purple arrow), Eq. (8); 1 N·s = 1 kg·m/s",
         ),
-        ("base vibration x<sub>b</sub>", _deflection(snap), "how far the base is bent from rest"),
-        ("hand's miss |e|", err, "how far the hand is from where the law sends it"),
+        (BASE_VIBRATION.html_name, _deflection(snap), "how far the base is bent from rest"),
+        (HAND_MISS.html_name, err, "how far the hand is from where the law sends it"),
         (
-            "reaction on base",
+            REACTION.html_name,
             si(r.reaction, "N", 1e-6, True),
             "red arrow: −(H_bm θ'' + c_b), Eq. (1): the arm's push on the base",
         ),
@@ -154,14 +155,14 @@ def dual_rows(snap: Snapshot) -> list[tuple[str, str, str]]:
             "how freely the task arm's hand moves; near 0 it is stretched out or folded",
         ),
         (
-            "momentum both arms hand over L = S H<sub>bm</sub>θ̇",
+            f"{MOMENTUM.html_name} = S H<sub>bm</sub>θ̇",
             si(r.L, "N·s", 1e-9, True),
-            "total momentum both arms hand to the base (purple arrow), Eq. (8): the compensator keeps it 0",
+            "the momentum both arms hand to the base (purple arrow), Eq. (8): the compensator keeps it 0",
         ),
-        ("x<sub>b</sub>", si(float(snap.q[0]), "m", 1e-9, True), "how far the base is bent from rest"),
-        ("end-effector error", si(r.ee_error, "m", floor=1e-9), "how far the task arm's hand is from the target"),
+        (BASE_VIBRATION.html_name, si(float(snap.q[0]), "m", 1e-9, True), "how far the base is bent from rest"),
+        (HAND_MISS.html_name, si(r.ee_error, "m", floor=1e-9), "how far the task arm's hand is from the target"),
         (
-            "residual reaction",
+            REACTION.html_name,
             si(r.reaction, "N", 1e-6, True),
             "red arrow: −(H_bm θ'' + c_b), Eq. (1), of both arms: what the compensator leaves on the base",
         ),

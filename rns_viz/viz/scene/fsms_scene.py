@@ -32,13 +32,14 @@ from rns_viz.viz.scene.framing import (
     is_narrow,
     main_panel_box,
 )
+from rns_viz.viz.scene.quantities import BASE_VIBRATION
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
 from rns_viz.viz.scene.robot import RobotMeshes
 from rns_viz.viz.scene.shapes import Trail, path_colours, path_family_segments, polyline_segments
 from rns_viz.viz.scene.style import BoomStyle, CartSpringStyle, DoubleBeamStyle, SceneStyle, style_for
 
-PATH_COLOUR = (0.62, 0.74, 0.88)  # other reactionless paths, RGB in [0, 1]
-PATH_HIGHLIGHT = (0.90, 0.05, 0.30)  # the current path
+PATH_COLOUR = (0.60, 0.63, 0.68)  # other reactionless paths: grey (the ghost is the blue), RGB in [0, 1]
+PATH_HIGHLIGHT = (0.90, 0.05, 0.30)  # the current path: crimson (the reaction arrow is the red)
 # The family is drawn in screen pixels: world-unit lines get a second, blended antialiasing pass in
 # viser's client, which made the ~1200 segments the costliest node of a software-rendered frame.
 PATH_WIDTH_PX = 4.0
@@ -370,7 +371,7 @@ class FsmsScene:
 
 def base_label(exaggeration: float) -> str:
     """The base's label: what it is, and how much larger than simulated its deflection is drawn."""
-    return f"base vibration x_b (drawn ×{exaggeration:g})"
+    return f"{BASE_VIBRATION.name} (drawn ×{exaggeration:g})"
 
 
 def _make_base_drawing(

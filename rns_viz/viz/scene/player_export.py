@@ -22,6 +22,7 @@ from rns_viz.live.loop.replay_mode import replay_snapshot
 from rns_viz.live.published.recording import Recording
 from rns_viz.live.published.snapshot import Overlays, ReplayView, Snapshot
 from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.quantities import REACTION
 from rns_viz.viz.scene.scene_callouts import SceneCallouts
 from rns_viz.viz.scene.teach_scene import TeachScene
 from rns_viz.viz.scene.view_toggles import ViewToggles
@@ -29,7 +30,6 @@ from rns_viz.viz.scene.view_toggles import ViewToggles
 RECORDING_NAME = "rns_scene.viser"
 PLAYER_URL = f"index.html?playbackPath={RECORDING_NAME}"  # open this from a static server of the folder
 FRAME_S = 1.0 / 30.0  # s of recorded time between drawn frames (the player's time resolution)
-REACTION_LABEL = "arm reaction"
 
 
 def scene_file(
@@ -49,7 +49,6 @@ def scene_file(
     try:
         scene = FsmsScene(server, recording.model, trail_frame="base")
         teach = TeachScene(server, recording.model, scene)
-        teach.reaction_label = REACTION_LABEL
         callouts = SceneCallouts(server, scene, teach.ghost, None, None)  # no page: each label at its point
         if overlays is not None:
             _draw_overlays(scene, teach, overlays)
@@ -66,7 +65,7 @@ def scene_file(
             with server.atomic():
                 scene.update(q, exaggeration)
                 wrench = snap.readouts.reaction_wrench  # all six rows on a 6-DOF base: arrows as live
-                scene.set_reaction_force(float(np.nan_to_num(snap.readouts.reaction)), REACTION_LABEL, wrench)
+                scene.set_reaction_force(float(np.nan_to_num(snap.readouts.reaction)), REACTION.name, wrench)
                 teach.draw(snap, snap.q_shadow, exaggeration, view)
                 callouts.frame(float(t), view.on("labels"))
         return serializer.serialize()

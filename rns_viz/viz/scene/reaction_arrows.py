@@ -57,6 +57,6 @@ class WrenchArrows:
                     text.position = tip
                     name = "force" if part == 0 else "moment"
                     text.text = (
-                        f"{label} {name} |{'F' if part == 0 else 'M'}| = {size:.3g} {unit} "
+                        f"{label}, {name} |{'F' if part == 0 else 'M'}| = {size:.3g} {unit} "
                         f"(({', '.join(f'{v:+.2g}' for v in vec)}) {unit}; {st.force_scale:.2g} m per {unit})"
                     )

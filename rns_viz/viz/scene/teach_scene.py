@@ -16,6 +16,7 @@ from rns_viz.live.reach.region import arm_reach
 from rns_viz.model import FsmsModel
 from rns_viz.viz.scene.fsms_scene import PATH_HIGHLIGHT, FsmsScene
 from rns_viz.viz.scene.ghost import Ghost
+from rns_viz.viz.scene.quantities import MOMENTUM, REACTION
 from rns_viz.viz.scene.region_outline import outline_points
 from rns_viz.viz.scene.view_toggles import ViewToggles
 
@@ -72,7 +73,6 @@ class TeachScene:
         self._outline_offset = np.array([0.0, 0.0, st.overlay_z - 0.5 * r])  # the outline node in the base's frame
         self._has_path = False
         self.has_reach = False  # the reachable set is drawn (set by the renderer with the overlays)
-        self.reaction_label = "arm reaction"
         self.one_d = model.n - len(model.selected) == 1  # a 1-D reaction null space: n and a path exist
         reach = arm_reach(model)
         theta0 = model.spec.default_configuration
@@ -83,7 +83,7 @@ class TeachScene:
         self.L_scale = st.force_arrow_max / max(coupling_sigma(model, theta0) * L_REF_RATE, 1e-12)
         self._L_origin = np.asarray(st.force_origin) + np.array([0.0, 0.0, 2.5 * r])
         self._axis = model.base_axes()[0] if model.base_is_translational else np.array([1.0, 0.0, 0.0])
-        # What was drawn (tests read these): n (kg m) and J n (m/s per unit u-bar) at the drawn theta, L (kg m/s).
+        # What was drawn (tests read these): n (kg m) and J n (m/s per unit u-bar) at the drawn theta, L (N s).
         self.n: np.ndarray | None = None
         self.jn: np.ndarray | None = None
         self.L = float("nan")
@@ -117,7 +117,7 @@ class TeachScene:
         if view.on("reaction") != sc.show_force:
             sc.show_force = view.on("reaction")
             f = snap.readouts.reaction
-            sc.set_reaction_force(f if np.isfinite(f) else 0.0, self.reaction_label, snap.readouts.reaction_wrench)
+            sc.set_reaction_force(f if np.isfinite(f) else 0.0, REACTION.name, snap.readouts.reaction_wrench)
         if view.on("trail") != sc.show_trail:
             sc.show_trail = view.on("trail")
             sc.trail_node.visible = sc.show_trail and len(sc.trail.points()) >= 2
@@ -131,7 +131,7 @@ class TeachScene:
             if self.coupling.visible:
                 self.coupling.visible = self.coupling_label.visible = False
             return
-        L = round(L, 4)  # kg m/s: finer changes are not drawn
+        L = round(L, 4)  # N s: finer changes are not drawn
         if L == self.L and self.coupling.visible:
             return
         self.L = L
@@ -142,7 +142,7 @@ class TeachScene:
             self.coupling_label.visible = True
             tip = self._L_origin + length * self._axis
             self.coupling_label.position = tip if show else self._L_origin
-            self.coupling_label.text = f"L = {L:.3g} kg·m/s"
+            self.coupling_label.text = f"{MOMENTUM.name} = {L:.3g} {MOMENTUM.unit}"
             self.coupling.visible = show
             if show:
                 self.coupling.points = np.stack([self._L_origin, tip])[None]

@@ -16,6 +16,7 @@ from rns_viz.live.operator.kinds import operator_class
 from rns_viz.live.teaching.rank_view import RANK_HINT
 from rns_viz.model import FsmsModel
 from rns_viz.viz.clients.connections import Connections
+from rns_viz.viz.scene.quantities import MOMENTUM, REACTION
 
 # (field, label, initial, hint): the hints are what a student reads on hovering.
 TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
@@ -29,7 +30,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "paths",
         "Other reactionless paths (grey)",
         False,
-        "The family of reactionless paths around the current one (red, always drawn): every way the hand can "
+        "The family of reactionless paths around the current one (crimson, always drawn): every way the hand can "
         "move without pushing the base, from other start poses.",
     ),
     (
@@ -48,16 +49,16 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
     ),
     (
         "reaction",
-        "Reaction force on the base (N)",
+        f"{REACTION.name.capitalize()} ({REACTION.unit})",
         True,
-        "Red arrow: the force the arm's motion puts on the base, −(H_bm θ'' + c_b) of Eq. (1), in newtons.",
+        "Red arrow: the force the arm's motion puts on the base, −(H_bm θ'' + c_b) of Eq. (1), in newtons (N).",
     ),
     (
         "coupling",
-        "Momentum handed to the base L (kg·m/s)",
+        f"{MOMENTUM.name.capitalize()} ({MOMENTUM.unit})",
         True,
-        "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8). "
-        "Zero on a reactionless path.",
+        "Purple arrow: the momentum the arm's joint motion hands to the base, L = H_bm θ' (Eq. 8), in N·s "
+        "(1 N·s = 1 kg·m/s). Zero on a reactionless path.",
     ),
     (
         "null_vector",
@@ -71,7 +72,7 @@ TOGGLES: tuple[tuple[str, str, bool, str], ...] = (
         "path_arrows",
         "Path direction arrows",
         True,
-        "Arrowheads on the red reactionless path pointing the way the arm moves when ū is positive.",
+        "Arrowheads on the crimson reactionless path pointing the way the arm moves when ū is positive.",
     ),
     (
         "reach",
@@ -99,10 +100,12 @@ class ViewToggles:
 
     def on(self, name: str) -> bool:
         box = self.boxes.get(name)
-        return True if box is None else box.value is True
+        return True if box is None else box.value is True and not box.disabled
 
     def show(self, name: str, on: bool = True) -> None:
-        """Tick or untick one toggle, as the server (the map for a gain lesson, a test)."""
+        """Tick or untick one toggle, as the server (the map for a gain lesson, a test); a toggle disabled for
+        the model stays unticked."""
+        on = on and not (name in self.boxes and self.boxes[name].disabled)
         self.good[name] = on
         if name in self.boxes and self.boxes[name].value != on:
             self.boxes[name].value = on
@@ -111,9 +114,49 @@ class ViewToggles:
         """Tick exactly ``names`` (a lesson's view), as the server: no refusal, no callback work."""
         wanted = set(names)
         for name, box in self.boxes.items():
-            self.good[name] = name in wanted
+            self.good[name] = name in wanted and not box.disabled
             if box.value != self.good[name]:
                 box.value = self.good[name]
+
+    def fit(self, model: FsmsModel) -> None:
+        """Disable (and untick) the toggles that draw nothing on ``model``, their hints saying why; enable the rest."""
+        why = nothing_to_show(model)
+        hints = {name: hint for name, _, _, hint in TOGGLES}
+        for name, box in self.boxes.items():
+            box.disabled = name in why
+            box.hint = f"{why[name]} {hints[name]}" if name in why else hints[name]
+            if name in why:
+                self.show(name, False)
+
+
+def nothing_to_show(model: FsmsModel) -> dict[str, str]:
+    """The toggles that cannot show anything on ``model``, each with the reason in plain words: the path
+    overlays need a single reactionless path (a 1-D reaction null space, Sec. III), the reachable region a
+    larger one, and the gain map a model whose gains the explorer analyses (not a compensating arm's)."""
+    kind = operator_class(model)
+    if kind.compensates:
+        no_path = "Not for this model: a second arm cancels the task arm's reaction, so no reactionless path is traced."
+    else:
+        no_path = (
+            "Not for this model: its reaction null space has two or more dimensions, so there is no single "
+            "reactionless path (the reachable region shows where the hand can go instead)."
+        )
+    why: dict[str, str] = {}
+    if kind.shows != "path":
+        why |= dict.fromkeys(("paths", "null_vector", "path_arrows"), no_path)
+    if kind.shows != "reachable set":
+        why["reach"] = (
+            "Not for this model: a second arm cancels the task arm's reaction, so the hand goes anywhere it reaches."
+            if kind.compensates
+            else "Not for this model: its reaction null space is one-dimensional, so the hand moves only along "
+            "its reactionless path."
+        )
+    if kind.compensates:
+        why["gain_map"] = (
+            "Not for this model: the gain map is computed for one arm damping the base's swing, not for a second "
+            "arm that cancels the reaction."
+        )
+    return why
 
 
 def first_look(model: FsmsModel) -> frozenset[str]:
@@ -140,7 +183,7 @@ def make_view_toggles(gui: viser.GuiApi, connections: Connections, shown: Iterab
         def _(event: viser.GuiEvent) -> None:
             if box.value == good[name]:
                 return
-            if isinstance(box.value, bool) and connections.allowed(event.client):
+            if isinstance(box.value, bool) and not box.disabled and connections.allowed(event.client):
                 good[name] = box.value
                 return
             if not connections.allowed(event.client):

@@ -33,6 +33,7 @@ from rns_viz.viz.panels.model_words import kick_hint, target_text
 from rns_viz.viz.panels.panel_text import readouts_html, status_html
 from rns_viz.viz.panels.preset_rows import preset_description, show_presets
 from rns_viz.viz.scene.fsms_scene import FsmsScene
+from rns_viz.viz.scene.quantities import REACTION
 from rns_viz.viz.scene.rank_scene import RankScene
 from rns_viz.viz.scene.scene_callouts import SceneCallouts
 from rns_viz.viz.scene.scene_nodes import node_names, resend_poses
@@ -42,7 +43,6 @@ from rns_viz.viz.server.drawn_factor import DrawnFactor
 from rns_viz.viz.server.frame_rate import PLOT_S, TEXT_S, frame_interval
 
 TARGET_HANDLE = f"{FsmsScene.BASE_AT_REST}/target_handle"  # at rest: the page drags it in that frame
-REACTION_LABEL = "arm reaction"
 KEPT_ACROSS_MODELS = ("gain_map", "labels")  # toggles a model switch leaves as they are
 # the names written in the scene that the *Labels* toggle hides (arrows' labels follow their arrows)
 
@@ -100,7 +100,6 @@ class Renderer:
         self.rank = RankScene(self.server, self.model, self.scene.style)
         self.kind = operator_class(self.model)  # what the operator drives: the panel's folders, laws and words
         dual = self.kind.compensates
-        self.teach.reaction_label = "residual reaction" if dual else REACTION_LABEL
         self.gui.plots.sides = COMPENSATION_SIDES if dual else SUPPRESSION_SIDES
         st = self.scene.style
         self.handle = self.server.scene.add_transform_controls(
@@ -121,6 +120,7 @@ class Renderer:
         self.gui.kick_peak.hint = kick_hint(self.model)
         if "rank" in self.view.boxes:  # only an arm of 2 or 3 joints has the overlay
             self.view.boxes["rank"].visible = has_rank_inset(self.model)
+        self.view.fit(self.model)  # toggles with nothing to draw on this model are disabled, saying why
         self.callouts = SceneCallouts(
             self.server,
             self.scene,
@@ -235,7 +235,7 @@ class Renderer:
                 self.scene.update(q, exaggeration)
                 f = snap.readouts.reaction  # N, exactly the readout's (Eq. 1); the label shows 3 digits
                 wrench = snap.readouts.reaction_wrench  # N, N m: all six rows for a 6-DOF base
-                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, self.teach.reaction_label, wrench)
+                self.scene.set_reaction_force(f if np.isfinite(f) else 0.0, REACTION.name, wrench)
             self.scene_updates += 1
 
     def _draw_target(self, snap: Snapshot) -> None:
