@@ -383,7 +383,11 @@ SCENE_COLOURS: dict[str, tuple[tuple[float, ...], tuple[str, ...]]] = {
     # the ghost takes its run's colour in the plots (blue: suppression on, red: off); the texts name the off one
     "ghost, suppression off": (
         GHOST_OFF_COLOUR,
-        (rf"{COLOUR} ghost \(suppression off\)", rf"{COLOUR} ghost is the shadow run, suppression off"),
+        (
+            rf"{COLOUR} ghost \(suppression off\)",
+            rf"{COLOUR} ghost is the shadow run, suppression off",
+            rf"\(suppression off\) as a {COLOUR} ghost",
+        ),
     ),
     "target": (TARGET_COLOUR, (rf"{COLOUR} target marker",)),
 }

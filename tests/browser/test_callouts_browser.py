@@ -123,6 +123,18 @@ def changed(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.abs(a - b).sum(axis=2) > CHANGED
 
 
+def laid_out_for(app: RnsApp, client) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the callouts' last layout was for the page's current size and view (the camera it last reported,
+    its projected points then still where the layout saw them)."""
+    scene, layout = app.renderer.callouts, app.renderer.callouts.callouts
+    seen, cam = layout._laid_out, client.camera
+    if seen is None or not seen[1] or tuple(seen[1][0][:2]) != (cam.image_width, cam.image_height):
+        return False
+    live = [c for c in layout.items.values() if c.shown and c.point is not None]
+    pages = scene.pages()
+    return bool(pages) and layout._same(layout._seen(live, pages, scene.solids(), scene.texts()))
+
+
 def pixels_at_rest(page, meshes: list, labels: list) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:  # type: ignore[no-untyped-def]
     """The arm's pixels and each label's, all read in one view (``labels`` hidden, ``meshes`` shown), and the
     pixels under the page's elements over the canvas (left out of both): a reference frame; the arm's pixels
@@ -178,7 +190,10 @@ def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
                 app.frame_robot(client)
                 with contextlib.suppress(AssertionError):  # a view still gliding shows in the pixels below
                     wait_until(lambda: at_rest(page, joints, app), 15.0, f"the view at rest at {w}x{h}")
-                time.sleep(0.5)  # a layout (every 0.2 s) for this view
+                # the labels laid out for this page as it now stands (on a busy machine the render thread can be
+                # seconds behind the view: labels placed for the previous size would be read at this one)
+                wait_until(lambda: laid_out_for(app, client), 30.0, f"the labels laid out at {w}x{h}")
+                time.sleep(0.5)  # a layout (every 0.25 s) for this view
                 assert abs(page.evaluate(DENSITY) - 1.0) < 0.01, "the page draws at the screen's density"
                 labels = shown_labels(app)
                 items = app.renderer.callouts.callouts.items

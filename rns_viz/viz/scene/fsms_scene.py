@@ -30,7 +30,6 @@ from rns_viz.viz.scene.framing import (
     frame_points,
     framed_points,
     is_narrow,
-    main_panel_box,
 )
 from rns_viz.viz.scene.quantities import BASE_VIBRATION
 from rns_viz.viz.scene.reaction_arrows import WrenchArrows
@@ -48,6 +47,7 @@ FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
 TARGET_COLOUR = (30, 170, 90)
 RESIZE_PX = 8  # a canvas that changed by at most this (px) each way keeps its framing
 REFRAME_SETTLE_S = 2.0  # s after a framing in which a page's new size frames it again (a resize comes in steps)
+MAP_FRAMED_TOP = 0.45  # NDC: the points framed with the gain map stay under this (the panel: ~200 px of 768)
 REACH_COLOUR = (196, 182, 236)  # pale, under the arm
 
 
@@ -293,10 +293,11 @@ class FsmsScene:
         cam = client.camera
         width, height = cam.image_width, cam.image_height
         aspect = width / height if width > 0 and height > 0 else DEFAULT_ASPECT
-        top, panel = 1.0, main_panel_box(width, height)
-        if self.also_framed is not None and panel is not None and height > 0:  # the map's top and title: below
-            top = 1.0 - 2.0 * min(panel[3] / height, 0.5)  # the floating panel (the robot alone may reach under it)
-        pose = self.camera_pose(cam.fov, aspect, is_narrow(width, height), top)
+        narrow = is_narrow(width, height)
+        # the map's top and title below the floating panel (the robot alone may reach under it); a fraction of
+        # the view, not the panel's px: a page's reported size changes with its drawing density, its framing not
+        top = MAP_FRAMED_TOP if self.also_framed is not None and not narrow else 1.0
+        pose = self.camera_pose(cam.fov, aspect, narrow, top)
         with client.atomic():
             cam.up_direction = (0.0, 0.0, 1.0)
             cam.position = pose.position  # (viser moves look_at with the position: it is set after)
