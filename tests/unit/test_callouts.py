@@ -177,3 +177,12 @@ def test_a_written_text_is_kept_clear_of_like_a_solid() -> None:
     page.add_box(box_at(at, legend.anchor, (width, height)))
     assert page.taken(_label_box(cam, item)) == 0
     assert item.placement is not None and item.placement.offset != (22.0, 0.0)
+
+
+def test_the_longest_callout_fits_a_phones_page() -> None:
+    """A label wider than the page has no place inside it: the layout then puts it anywhere (the 3R's region
+    edge had landed under a phone's panel sheet). Its words are in two lines."""
+    from rns_viz.viz.scene.callout_layout import EDGE_PX
+    from rns_viz.viz.scene.teach_scene import EDGE_TEXT
+
+    assert text_size(EDGE_TEXT)[0] <= 390 - 2 * EDGE_PX < text_size(EDGE_TEXT.replace("\n", " "))[0]

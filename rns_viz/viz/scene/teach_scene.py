@@ -23,7 +23,7 @@ from rns_viz.viz.scene.view_toggles import ViewToggles
 L_COLOUR = (120, 40, 170)  # purple: coupling momentum
 N_COLOUR = (235, 130, 0)  # orange: null-space direction at the hand
 OUTLINE_COLOUR = (110, 60, 190)  # the reachable region's edge, darker than its dots
-EDGE_TEXT = "edge of the reactionless region: a fold, J̄ loses rank"
+EDGE_TEXT = "edge of the reactionless region:\na fold, J̄ loses rank"  # two lines: one is wider than a phone
 PATH_ARROWS = 8  # arrowheads along the current path
 L_REF_RATE = 1.0  # rad/s: a joint rate that draws L at full arrow length (with sigma_min(S H_bm) at the start)
 
