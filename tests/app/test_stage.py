@@ -334,6 +334,12 @@ def test_a_page_is_framed_again_for_a_new_size_unless_its_view_was_moved(trep_ap
         time.sleep(REFRAME_SETTLE_S)  # the page settled
         ws.camera(wxyz, tuple(framed((1200, 700))), size=(1000, 720))  # resized, the view as framed
         wait_until(lambda: at((1000, 720)), 10.0, "the page framed for its new size")
+        # the drawing density lowered (a slow page): the same shape in fewer px frames nothing again (the
+        # framing follows the shape; re-framing at each density change kept a slow page from settling)
+        framed_at = trep_app.scene.framed_pages[client.client_id][2]
+        ws.camera(wxyz, tuple(framed((1000, 720))), size=(750, 540))
+        wait_until(lambda: client.camera.image_width == 750, 10.0, "the lower density reported")
+        assert trep_app.scene.framed_pages[client.client_id][2] == framed_at
         moved = (3.0, -2.0, 1.5)
         time.sleep(REFRAME_SETTLE_S)  # (a size reported within this of a framing is the page still settling)
         ws.camera(wxyz, moved, size=(1000, 720))  # the user orbits ...

@@ -325,6 +325,8 @@ class FsmsScene:
         (w0, h0), position, when = last
         if abs(width - w0) <= RESIZE_PX and abs(height - h0) <= RESIZE_PX:  # the same page, to rounding
             return
+        if abs(width * h0 - height * w0) <= RESIZE_PX * max(width, height):  # the same shape: its drawing density
+            return  # changed (viser lowers it on a slow page), and the framing, which follows the shape, with it not
         turned = is_narrow(w0, h0) != is_narrow(width, height)
         distance = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
         untouched = bool(np.allclose(cam.position, position, atol=1e-4 * max(distance, 1e-3)))
