@@ -183,16 +183,10 @@ def url_page(
 
 @contextmanager
 def browser_page(
-    server: viser.ViserServer,
-    width: int = 1280,
-    height: int = 800,
-    timeout: float = 30.0,
-    draw: bool = False,
-    query: str = "",
+    server: viser.ViserServer, width: int = 1280, height: int = 800, timeout: float = 30.0, draw: bool = False
 ) -> Iterator[Page]:
-    """A Playwright page showing ``server`` (its address followed by ``query``, e.g. ``"?fixedDpr=1"``), yielded
-    once the client has connected (:func:`url_page`)."""
-    with url_page(f"http://127.0.0.1:{server.get_port()}/{query}", width, height, timeout, draw) as page:
+    """A Playwright page showing ``server``, yielded once the client has connected (:func:`url_page`)."""
+    with url_page(f"http://127.0.0.1:{server.get_port()}/", width, height, timeout, draw) as page:
         wait_until(lambda: len(server.get_clients()) > 0, timeout, "the browser to connect to viser")
         yield page
 
