@@ -269,6 +269,23 @@ def shown_on_canvas(page: Page, where: np.ndarray) -> np.ndarray:
     return np.asarray(shown, dtype=bool).reshape(np.asarray(where).shape[:-1])
 
 
+def covering(page: Page, where: np.ndarray) -> str:
+    """What the page shows topmost at the pixel ``where`` (2,): its tag and classes (for a failure's words)."""
+    return str(
+        page.evaluate(
+            "([x, y]) => { const e = document.elementFromPoint(x, y);"
+            " return e ? `${e.tagName.toLowerCase()}.${[...e.classList].join('.')}` : 'nothing (off the page)'; }",
+            [float(where[0]), float(where[1])],
+        )
+    )
+
+
+# Toasts sit at the page's top-left, over the map's high-g_m, low-g_b corner; one that arrives on a busy machine
+# while the cells are read (or is still leaving) covered the fastest cell in CI. They are hidden while the
+# map's pixels are read: what is checked is the map's drawing, not the page's messages.
+HIDE_TOASTS_CSS = ".mantine-Notifications-root { display: none !important; }"
+
+
 def read_pixels(page: Page, where: np.ndarray) -> np.ndarray:
     """(..., 3) colours of the page at the pixels ``where`` (..., 2): the median of the 3 x 3 around each."""
     shot = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
@@ -311,6 +328,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     centre = screen_point(page, (0.0, 0.0, 0.0))
     assert centre is not None
     page.mouse.move(*(centre if hovered else (5.0, 5.0)))
+    hide_toasts = page.add_style_tag(content=HIDE_TOASTS_CSS)
     deadline = time.monotonic() + PICTURE_WAIT_S
     while True:
         face_again_if_framed(app, page, scene)
@@ -330,6 +348,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
         agree = agreeing(gm, drawn, want)
         if (agree[read].mean() >= AGREEING_CELLS and on_canvas.all()) or time.monotonic() > deadline:
             break
+    hide_toasts.evaluate("(style) => style.remove()")
     for mark in marks:
         mark.visible = True  # type: ignore[attr-defined]
     app.view.show("labels", labels_were)
@@ -346,6 +365,9 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     slowest = np.unravel_index(np.argmin(np.where(coloured, rates, np.inf)), rates.shape)
     bottom, top = colours(np.array(scale), scale).astype(int)  # the legend's dark and yellow ends
     for (i, j), end, name in ((fastest, top, "highest"), (slowest, bottom, "lowest")):
+        if not on_canvas[i, j]:
+            screenshot(page, f"gain_map_covered_{app.model_name}_{quantity}")
+        assert on_canvas[i, j], f"{quantity}: the cell of the {name} rate is under {covering(page, cells[i, j])}"
         assert np.abs(drawn[i, j] - end).max() <= COLOUR_TOLERANCE, (
             f"{quantity}: the cell of the {name} rate ({rates[i, j]:.3g} 1/s at g_b {gm.g_b[i]:.3g}, g_m "
             f"{gm.g_m[j]:.3g}) is drawn {drawn[i, j]}, the legend's {name} end is {end}"
