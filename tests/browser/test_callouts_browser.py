@@ -22,7 +22,7 @@ from rns_viz.viz.server.app import RnsApp, start_app
 from tests.browser.test_stage_browser import at_rest, canvas_box, reported_size, reports, shown_size
 from tests.support.browser import (
     browser_page,
-    dismiss_notifications,
+    hide_toasts,
     screenshot,
     wait_for_frames,
     wait_for_nodes,
@@ -106,7 +106,7 @@ def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
         joints = [name for name in app.scene.robot.node_names[app.model.m :] if name]
         with browser_page(app.server, width=SIZES[0][0], height=SIZES[0][1], draw=True) as page:
             wait_for_nodes(page, set(joints))
-            dismiss_notifications(page)
+            hide_toasts(page)  # the test reads the scene's pixels: a toast arriving later would be read as drawing
             client = next(iter(app.server.get_clients().values()))
             app.session.pause()
             # the overlays a background job computes (boom7's and trep2's reachable set) drawn before any picture

@@ -36,6 +36,7 @@ from tests.support.browser import (
     browser_page,
     dismiss_notifications,
     each_model_app,  # noqa: F401 (the fixture 'app')
+    hide_toasts,
     open_folder,
     screenshot,
     settle_for_picture,
@@ -280,12 +281,6 @@ def covering(page: Page, where: np.ndarray) -> str:
     )
 
 
-# Toasts sit at the page's top-left, over the map's high-g_m, low-g_b corner; one that arrives on a busy machine
-# while the cells are read (or is still leaving) covered the fastest cell in CI. They are hidden while the
-# map's pixels are read: what is checked is the map's drawing, not the page's messages.
-HIDE_TOASTS_CSS = ".mantine-Notifications-root { display: none !important; }"
-
-
 def read_pixels(page: Page, where: np.ndarray) -> np.ndarray:
     """(..., 3) colours of the page at the pixels ``where`` (..., 2): the median of the 3 x 3 around each."""
     shot = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
@@ -328,7 +323,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
     centre = screen_point(page, (0.0, 0.0, 0.0))
     assert centre is not None
     page.mouse.move(*(centre if hovered else (5.0, 5.0)))
-    hide_toasts = page.add_style_tag(content=HIDE_TOASTS_CSS)
+    toasts_hidden = hide_toasts(page)  # a toast arriving late sat over the fastest cell (top-left) in CI
     deadline = time.monotonic() + PICTURE_WAIT_S
     while True:
         face_again_if_framed(app, page, scene)
@@ -348,7 +343,7 @@ def check_drawn_map(app: RnsApp, page: Page, quantity: str, hovered: bool = Fals
         agree = agreeing(gm, drawn, want)
         if (agree[read].mean() >= AGREEING_CELLS and on_canvas.all()) or time.monotonic() > deadline:
             break
-    hide_toasts.evaluate("(style) => style.remove()")
+    toasts_hidden.evaluate("(style) => style.remove()")
     for mark in marks:
         mark.visible = True  # type: ignore[attr-defined]
     app.view.show("labels", labels_were)

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
-from playwright.sync_api import Browser, Page, Playwright, sync_playwright
+from playwright.sync_api import Browser, ElementHandle, Page, Playwright, sync_playwright
 
 from rns_viz.viz.server.app import TARGET_HANDLE, RnsApp, start_app
 from tests.support.repo import REPO
@@ -215,6 +215,17 @@ def dismiss_notifications(page: Page) -> None:
     on each close button in one call (a software-rendered page answers each Playwright action only after
     its next frame, so one locator click per toast took ~1 s)."""
     page.evaluate("() => document.querySelectorAll('.mantine-Notification-closeButton').forEach((b) => b.click())")
+
+
+# Toasts sit at the page's top-left, over the scene: one that arrives on a busy machine while a test reads the
+# scene's pixels (or is still leaving after a close) is read as part of the drawing.
+HIDE_TOASTS_CSS = ".mantine-Notifications-root { display: none !important; }"
+
+
+def hide_toasts(page: Page) -> ElementHandle:
+    """Hide the page's toasts from now on (for a test that reads the scene's pixels); the returned style
+    element's removal shows them again."""
+    return page.add_style_tag(content=HIDE_TOASTS_CSS)
 
 
 def open_folder(page: Page, label: str) -> None:
