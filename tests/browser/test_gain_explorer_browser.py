@@ -19,7 +19,7 @@ from rns_viz.analysis import GainMap
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.viz.panels.gain_panel import QUANTITIES
 from rns_viz.viz.scene.framing import main_panel_box
-from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, RESIZE_PX
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, framing_holds
 from rns_viz.viz.scene.gain_scene import (
     MISSING_RGB,
     UNSTABLE_HATCH,
@@ -200,7 +200,7 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
         if framed is None:
             return False
         (fw, fh), _, when = framed  # (the same shape: viser may have lowered the page's drawing density since)
-        same_shape = fw > 0 and abs(fw * size[1] - fh * size[0]) <= RESIZE_PX * max(size)
+        same_shape = fw > 0 and framing_holds((fw, fh), size)
         return same_shape and time.monotonic() - when > REFRAME_SETTLE_S
 
     wait_until(settled, 30.0, "the page's own framing settled")

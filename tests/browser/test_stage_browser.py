@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rns_viz.viz.scene.framing import is_narrow
-from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, RESIZE_PX
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, framing_holds
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     PROJECT,
@@ -201,10 +201,16 @@ def test_robot_framed_and_plot_in_view_at_three_sizes(model: str) -> None:
             def framed_for_now() -> bool:  # the app's last framing of this page is for (about) its size now
                 (fw, fh), position, _ = app.scene.framed_pages[client.client_id]
                 cw, ch = reported_size(client)
-                near = abs(fw - cw) <= RESIZE_PX and abs(fh - ch) <= RESIZE_PX
+                near = framing_holds((fw, fh), (cw, ch))  # the product's rule: a density change keeps a framing
                 return near and not is_narrow(fw, fh) and np.allclose(client.camera.position, position, atol=1e-4)
 
-            wait_until(framed_for_now, 15.0, "the page framed again")
+            try:
+                wait_until(framed_for_now, 15.0, "the page framed again")
+            except AssertionError as e:
+                (fw, fh), position, _ = app.scene.framed_pages[client.client_id]
+                seen = f"framed for {fw}x{fh}, reported {reported_size(client)}, camera moved since: "
+                seen += str(not np.allclose(client.camera.position, position, atol=1e-4))
+                raise AssertionError(f"{e}: {seen}") from e
             time.sleep(REFRAME_SETTLE_S)  # the page settled: a size it reports now no longer re-frames it
             for attempt in range(3):  # the camera flown away (again, if a framing of the page crossed the move)
                 client.camera.position = client.camera.position + np.array(

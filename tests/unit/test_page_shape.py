@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from rns_viz.viz.scene.framing import NARROW_BAND, band_for, is_narrow, main_panel_box
+from rns_viz.viz.scene.fsms_scene import framing_holds
 
 PHONES = [(390, 844), (430, 932), (412, 785), (360, 800), (390, 664)]  # CSS px, upright, toolbars or not
 DESKTOPS = [(536, 800), (622, 768), (696, 900), (1176, 1080)]  # the scene between the docked panels
@@ -35,3 +36,14 @@ def test_a_paced_pages_panel_covers_its_slowed_line_too() -> None:
     assert plain is not None and slowed is not None
     assert slowed[:3] == plain[:3] and slowed[3] == plain[3] + NOTICE_HEIGHT_PX
     assert main_panel_box(390, 844, notice=True) is None
+
+
+@pytest.mark.parametrize("density", [0.75, 0.875, 2.0])
+def test_a_framing_holds_through_a_density_change_and_not_through_a_new_shape(density: float) -> None:
+    """A page framed at one size keeps the framing when viser changes its drawing density (the size scales,
+    the shape stays) or the size moves by rounding; a new shape (a phone turned wide, a panel docked) does not."""
+    framed = (614.0, 768.0)
+    assert framing_holds(framed, (614.0, 768.0)) and framing_holds(framed, (619.0, 764.0))
+    assert framing_holds(framed, (round(614 * density), round(768 * density)))
+    assert not framing_holds(framed, (390.0 * density, 844.0 * density))
+    assert not framing_holds(framed, (1366.0 * density, 768.0 * density))

@@ -46,6 +46,18 @@ TRAIL_COLOUR = (0.20, 0.65, 0.30)
 FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
 TARGET_COLOUR = (30, 170, 90)
 RESIZE_PX = 8  # a canvas that changed by at most this (px) each way keeps its framing
+
+
+def framing_holds(framed: tuple[float, float], size: tuple[float, float]) -> bool:
+    """Whether a page framed at canvas size ``framed`` (w, h) keeps that framing at ``size``: the same size to
+    rounding, or the same shape (its drawing density changed, which viser lowers on a slow page: the framing
+    follows the shape, so it holds)."""
+    (w0, h0), (w, h) = framed, size
+    if abs(w - w0) <= RESIZE_PX and abs(h - h0) <= RESIZE_PX:
+        return True
+    return abs(w * h0 - h * w0) <= RESIZE_PX * max(w, h)
+
+
 REFRAME_SETTLE_S = 2.0  # s after a framing in which a page's new size frames it again (a resize comes in steps)
 MAP_FRAMED_TOP = 0.45  # NDC: the points framed with the gain map stay under this (the panel: ~200 px of 768)
 REACH_COLOUR = (196, 182, 236)  # pale, under the arm
@@ -323,10 +335,8 @@ class FsmsScene:
             self.frame_client(client)
             return
         (w0, h0), position, when = last
-        if abs(width - w0) <= RESIZE_PX and abs(height - h0) <= RESIZE_PX:  # the same page, to rounding
+        if framing_holds((w0, h0), (width, height)):
             return
-        if abs(width * h0 - height * w0) <= RESIZE_PX * max(width, height):  # the same shape: its drawing density
-            return  # changed (viser lowers it on a slow page), and the framing, which follows the shape, with it not
         turned = is_narrow(w0, h0) != is_narrow(width, height)
         distance = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
         untouched = bool(np.allclose(cam.position, position, atol=1e-4 * max(distance, 1e-3)))
