@@ -14,12 +14,13 @@ import numpy as np
 import pytest
 from PIL import Image
 from playwright.sync_api import Page
+from viser import ClientHandle
 
 from rns_viz.analysis import GainMap
 from rns_viz.live.runs.laws import LAW_LABELS
 from rns_viz.viz.panels.gain_panel import QUANTITIES
 from rns_viz.viz.scene.framing import main_panel_box
-from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, framing_holds
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S
 from rns_viz.viz.scene.gain_scene import (
     MISSING_RGB,
     UNSTABLE_HATCH,
@@ -193,17 +194,17 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     cam = client.camera
     wait_until(lambda: cam.update_timestamp > 0 and cam.image_width > 0, 10.0, "the page's camera")
 
-    def settled() -> bool:  # the app framed the page for the shape it reports, long enough ago that a size it
-        # reports now (the docked panels take their widths over the first seconds) no longer frames it again
+    def settled() -> bool:  # the app framed the page long enough ago that what it reports now (the docked panels
+        # take their widths over the first seconds) does not frame it again: a framing would move the faced camera
         framed = app.scene.framed_pages.get(client.client_id)
-        size = (int(cam.image_width), int(cam.image_height))
-        if framed is None:
+        if framed is None or app.scene.needs_framing(client):
             return False
-        (fw, fh), _, when = framed  # (the same shape: viser may have lowered the page's drawing density since)
-        same_shape = fw > 0 and framing_holds((fw, fh), size)
-        return same_shape and time.monotonic() - when > REFRAME_SETTLE_S
+        return time.monotonic() - framed[2] > REFRAME_SETTLE_S
 
-    wait_until(settled, 30.0, "the page's own framing settled")
+    try:
+        wait_until(settled, 30.0, "the page's own framing settled")
+    except AssertionError as e:  # said, and the map faced anyway: a framing after this is faced again (below)
+        print(f"\n{app.model_name}: {e} ({page_framing(app, client)})", end="")
     # The floating main panel minimised to its bar: its height follows its words (a long operator notice
     # made it reach over the map's top rows in CI); the map is faced below where it stands expanded.
     app.server.gui.main_panel.minimize()
@@ -229,6 +230,16 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     wait_for_frames(page, 10)
 
 
+def page_framing(app: RnsApp, client: ClientHandle) -> str:
+    """The page's last framing and what it reports now, in words (for a test's message)."""
+    (fw, fh), position, when = app.scene.framed_pages[client.client_id]
+    moved = not np.allclose(client.camera.position, position, atol=1e-4)
+    return (
+        f"framed {time.monotonic() - when:.1f} s ago for {fw}x{fh}, reports"
+        f" {client.camera.image_width}x{client.camera.image_height}, camera moved since: {moved}"
+    )
+
+
 FACED: dict[int, np.ndarray] = {}  # client id -> where face_the_map put its camera (m)
 
 
@@ -242,8 +253,7 @@ def face_again_if_framed(app: RnsApp, page: Page, scene: GainScene) -> None:
     here = np.asarray(client.camera.position, dtype=float)
     if np.allclose(here, faced, atol=1e-4 * max(float(np.linalg.norm(faced - scene.centre)), 1e-3)):
         return
-    (fw, fh), _, when = app.scene.framed_pages[client.client_id]
-    print(f"\n{app.model_name}: framed {time.monotonic() - when:.1f} s ago for {fw}x{fh}: map faced again", end="")
+    print(f"\n{app.model_name}: {page_framing(app, client)}: map faced again", end="")
     face_the_map(app, page, scene)
 
 

@@ -14,8 +14,8 @@ import time
 import numpy as np
 import pytest
 
-from rns_viz.viz.scene.framing import is_narrow
-from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S, framing_holds
+from rns_viz.viz.scene.framing import framing_holds, is_narrow
+from rns_viz.viz.scene.fsms_scene import REFRAME_SETTLE_S
 from rns_viz.viz.server.app import RnsApp, start_app
 from tests.support.browser import (
     PROJECT,

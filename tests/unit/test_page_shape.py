@@ -6,8 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from rns_viz.viz.scene.framing import NARROW_BAND, band_for, is_narrow, main_panel_box
-from rns_viz.viz.scene.fsms_scene import framing_holds
+from rns_viz.viz.scene.framing import NARROW_BAND, band_for, framing_holds, is_narrow, main_panel_box
 
 PHONES = [(390, 844), (430, 932), (412, 785), (360, 800), (390, 664)]  # CSS px, upright, toolbars or not
 DESKTOPS = [(536, 800), (622, 768), (696, 900), (1176, 1080)]  # the scene between the docked panels

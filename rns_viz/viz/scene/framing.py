@@ -101,6 +101,19 @@ def is_narrow(width: float, height: float) -> bool:
     return width > 0 and height > 0 and width / height < NARROW_ASPECT
 
 
+RESIZE_PX = 8  # a canvas that changed by at most this (px) each way keeps its framing
+
+
+def framing_holds(framed: tuple[float, float], size: tuple[float, float]) -> bool:
+    """Whether a page framed at canvas size ``framed`` (w, h) keeps that framing at ``size``: the same size to
+    rounding, or the same shape (its drawing density changed, which viser lowers on a slow page: the framing
+    follows the shape, so it holds)."""
+    (w0, h0), (w, h) = framed, size
+    if abs(w - w0) <= RESIZE_PX and abs(h - h0) <= RESIZE_PX:
+        return True
+    return abs(w * h0 - h * w0) <= RESIZE_PX * max(w, h)
+
+
 def band_for(width: float, height: float) -> tuple[float, float]:
     """The vertical band of the view the robot is fitted into on a scene of this size."""
     return NARROW_BAND if is_narrow(width, height) else (-1.0, 1.0)

@@ -29,6 +29,7 @@ from rns_viz.viz.scene.framing import (
     CameraPose,
     frame_points,
     framed_points,
+    framing_holds,
     is_narrow,
 )
 from rns_viz.viz.scene.quantities import BASE_VIBRATION
@@ -45,19 +46,6 @@ PATH_WIDTH_PX = 4.0
 TRAIL_COLOUR = (0.20, 0.65, 0.30)
 FORCE_COLOUR = (180, 0, 0)  # lit arrows render lighter than their colour
 TARGET_COLOUR = (30, 170, 90)
-RESIZE_PX = 8  # a canvas that changed by at most this (px) each way keeps its framing
-
-
-def framing_holds(framed: tuple[float, float], size: tuple[float, float]) -> bool:
-    """Whether a page framed at canvas size ``framed`` (w, h) keeps that framing at ``size``: the same size to
-    rounding, or the same shape (its drawing density changed, which viser lowers on a slow page: the framing
-    follows the shape, so it holds)."""
-    (w0, h0), (w, h) = framed, size
-    if abs(w - w0) <= RESIZE_PX and abs(h - h0) <= RESIZE_PX:
-        return True
-    return abs(w * h0 - h * w0) <= RESIZE_PX * max(w, h)
-
-
 REFRAME_SETTLE_S = 2.0  # s after a framing in which a page's new size frames it again (a resize comes in steps)
 MAP_FRAMED_TOP = 0.45  # NDC: the points framed with the gain map stay under this (the panel: ~200 px of 768)
 REACH_COLOUR = (196, 182, 236)  # pale, under the arm
@@ -321,27 +309,30 @@ class FsmsScene:
         )
 
     def follow_page_size(self, client: viser.ClientHandle) -> None:
-        """On a page's camera message: frame it if it never was; again if its canvas changed size while its
-        view is still the one framed (nobody moved it) or the page is still settling from the last framing (a
-        resize comes as several sizes, while the view may still glide), or if it turned narrow or wide (a phone's
-        panel sheet then covers or leaves the scene's lower part, where the arm would hide). A view the user
-        moved stays."""
+        """On a page's camera message: frame it if :meth:`needs_framing` says so."""
+        if self.needs_framing(client):
+            self.frame_client(client)
+
+    def needs_framing(self, client: viser.ClientHandle) -> bool:
+        """Whether the page's last camera message asks for a framing: it never was framed; or its canvas
+        changed size (beyond :func:`framing_holds`) while its view is still the one framed (nobody moved it) or
+        the page is still settling from the last framing (a resize comes as several sizes, while the view may
+        still glide), or it turned narrow or wide (a phone's panel sheet then covers or leaves the scene's lower
+        part, where the arm would hide). A view the user moved stays."""
         cam = client.camera
         width, height = cam.image_width, cam.image_height
         if width <= 0 or height <= 0:
-            return
+            return False
         last = self.framed_pages.get(client.client_id)
         if last is None:
-            self.frame_client(client)
-            return
+            return True
         (w0, h0), position, when = last
         if framing_holds((w0, h0), (width, height)):
-            return
+            return False
         turned = is_narrow(w0, h0) != is_narrow(width, height)
         distance = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
         untouched = bool(np.allclose(cam.position, position, atol=1e-4 * max(distance, 1e-3)))
-        if turned or untouched or time.monotonic() - when < REFRAME_SETTLE_S:
-            self.frame_client(client)
+        return turned or untouched or time.monotonic() - when < REFRAME_SETTLE_S
 
     # -- internals -----------------------------------------------------------------------------
     def _trail_point(self) -> np.ndarray:
