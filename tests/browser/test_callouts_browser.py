@@ -57,9 +57,32 @@ def laid_out_for(app: RnsApp, client) -> bool:  # type: ignore[no-untyped-def]
     return bool(pages) and layout._same(layout._seen(live, pages, scene.solids(), scene.texts()))
 
 
+# The page's panels over the scene (the floating main panel; a phone's sheet, whose live plots redraw while the
+# page is read) and its toasts: their pixels are not the scene's.
+OVERLAYS = ".mantine-Paper-root, .mantine-Notifications-root"
+
+
+def covered(page, box: dict[str, float], shape: tuple[int, int]) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """(h, w) bool: the pixels of the canvas's visible part (``box``, clipped to ``shape``) under a panel."""
+    rects = page.evaluate(
+        "(sel) => [...document.querySelectorAll(sel)].filter((e) => getComputedStyle(e).visibility !== 'hidden')"
+        ".map((e) => e.getBoundingClientRect()).map((r) => [r.left, r.top, r.right, r.bottom])",
+        OVERLAYS,
+    )
+    mask = np.zeros(shape, dtype=bool)
+    x0, y0 = max(box["x"], 0.0), max(box["y"], 0.0)
+    for left, top, right, bottom in rects:
+        c0, r0 = max(int(np.floor(left - x0)), 0), max(int(np.floor(top - y0)), 0)
+        c1, r1 = int(np.ceil(right - x0)), int(np.ceil(bottom - y0))
+        if c1 > 0 and r1 > 0:
+            mask[r0:r1, c0:c1] = True
+    return mask
+
+
 def canvas_pixels(page) -> np.ndarray:  # type: ignore[no-untyped-def]
     """The 3-D canvas's visible part, RGB ints (h, w, 3), once two frames half a second apart are the same
-    (the page's camera glides to a new view for a while, by less than a pixel a frame at its end)."""
+    (the page's camera glides to a new view for a while, by less than a pixel a frame at its end); the pixels
+    under a panel are -1 (not the scene's, and never changed)."""
 
     def grab() -> np.ndarray:
         wait_for_frames(page, 4)
@@ -67,8 +90,9 @@ def canvas_pixels(page) -> np.ndarray:  # type: ignore[no-untyped-def]
         vw, vh = page.viewport_size["width"], page.viewport_size["height"]
         x0, y0 = int(max(c["x"], 0)), int(max(c["y"], 0))
         x1, y1 = int(min(c["x"] + c["w"], vw)), int(min(c["y"] + c["h"], vh))
-        img = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
-        return img[y0:y1, x0:x1]
+        img = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)[y0:y1, x0:x1]
+        img[covered(page, c, img.shape[:2])] = -1
+        return img
 
     before = grab()
     deadline = time.monotonic() + 20.0
@@ -145,6 +169,7 @@ def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
                 for mesh in meshes:
                     mesh.visible = False
                 arm = pixels_of(page, meshes)
+                panels = covered(page, canvas_box(page), arm.shape)
                 for mesh in meshes:
                     mesh.visible = True
                 assert arm.sum() > 1000, "the arm is drawn"
@@ -162,6 +187,10 @@ def test_labels_keep_off_the_arm_and_each_other(model: str) -> None:
                     # whole: not cut by the scene's edges (beyond them: the docked panels or the page's edge)
                     inside = cols.min() > 0 and cols.max() < mask.shape[1] - 1 and rows.min() > 0
                     assert inside and rows.max() < mask.shape[0] - 1, (w, h, text, "cut at the scene's edge")
+                    # nor under a panel (the floating one; a phone's sheet): no pixel of it or beside it is one's
+                    rim = np.zeros_like(mask)
+                    rim[max(rows.min() - 1, 0) : rows.max() + 2, max(cols.min() - 1, 0) : cols.max() + 2] = True
+                    assert not (rim & panels).any(), (w, h, text, "under a panel")
                 texts = list(masks)
                 for i, a in enumerate(texts):
                     for b in texts[i + 1 :]:
