@@ -209,11 +209,7 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     # made it reach over the map's top rows in CI); the map is faced below where it stands expanded.
     app.server.gui.main_panel.minimize()
     # the scene's own canvas as laid out now, between the docked panels (the camera's size may predate them)
-    width, height = page.evaluate(
-        "() => { const c = [...document.querySelectorAll('canvas')].sort((a, b) =>"
-        " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
-        " return [c.clientWidth, c.clientHeight]; }"
-    )
+    width, height = scene_canvas_size(page)
     panel = main_panel_box(width, height)
     below = panel[3] if panel is not None else 0.0  # px: the rows above are partly under the main panel
     free = height - below
@@ -226,8 +222,18 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     shift = -0.5 * below / focal * distance * up  # the map's centre half the panel's rows down the page
     cam.position = scene.centre + distance * scene.rotation[:, 2] - shift
     cam.look_at = scene.centre - shift
-    FACED[client.client_id] = np.array(cam.position, dtype=float)
+    FACED[client.client_id] = (np.array(cam.position, dtype=float), (width, height))
     wait_for_frames(page, 10)
+
+
+def scene_canvas_size(page: Page) -> tuple[int, int]:
+    """The scene's canvas as laid out now (CSS px), between the docked panels."""
+    width, height = page.evaluate(
+        "() => { const c = [...document.querySelectorAll('canvas')].sort((a, b) =>"
+        " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
+        " return [c.clientWidth, c.clientHeight]; }"
+    )
+    return int(width), int(height)
 
 
 def page_framing(app: RnsApp, client: ClientHandle) -> str:
@@ -240,20 +246,28 @@ def page_framing(app: RnsApp, client: ClientHandle) -> str:
     )
 
 
-FACED: dict[int, np.ndarray] = {}  # client id -> where face_the_map put its camera (m)
+# client id -> where face_the_map put its camera (m), and the canvas's size (px) it faced the map for
+FACED: dict[int, tuple[np.ndarray, tuple[int, int]]] = {}
 
 
 def face_again_if_framed(app: RnsApp, page: Page, scene: GainScene) -> None:
     """Face the map again if the app framed the page since (seen in CI on a busy machine: a framing landed
-    after the map was faced, and the cells were 1.6 px apart); says so, with the page's last framing."""
+    after the map was faced, and the cells were 1.6 px apart) or the scene's canvas changed size since (seen
+    in CI: the docked panels took their widths after the map was faced, and its left column went under one);
+    says so."""
     client = next(iter(app.server.get_clients().values()))
     faced = FACED.get(client.client_id)
     if faced is None:
         return
+    position, size = faced
     here = np.asarray(client.camera.position, dtype=float)
-    if np.allclose(here, faced, atol=1e-4 * max(float(np.linalg.norm(faced - scene.centre)), 1e-3)):
+    moved = not np.allclose(here, position, atol=1e-4 * max(float(np.linalg.norm(position - scene.centre)), 1e-3))
+    now = scene_canvas_size(page)
+    resized = max(abs(now[0] - size[0]), abs(now[1] - size[1])) > 2
+    if not (moved or resized):
         return
-    print(f"\n{app.model_name}: {page_framing(app, client)}: map faced again", end="")
+    why = page_framing(app, client) if moved else f"the canvas {size[0]}x{size[1]} -> {now[0]}x{now[1]} px"
+    print(f"\n{app.model_name}: {why}: map faced again", end="")
     face_the_map(app, page, scene)
 
 
