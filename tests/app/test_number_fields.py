@@ -82,7 +82,8 @@ def test_a_typed_number_is_applied_exactly_or_refused_with_a_message(
     typing_app: tuple[RnsApp, ProtocolClient, Told],
 ) -> None:
     app, client, told = typing_app
-    app.session.advance(0.5)  # a path to scrub along
+    app.session.advance(0.5)  # a path to scrub along: the helper's path table, taken by the stepped loop
+    assert app.session.wait_background(60.0), "the path table"  # (seconds beside other tests' workers)
     wait_until(lambda: not app.gui.sigma.disabled, 10.0, "the path field")
     checked = 0
     replay_only = (app.replay.speed, app.replay.timeline)  # (inputs to a replay running: tested below)
