@@ -4,12 +4,14 @@ turned ``1e9`` into 19). Text is sent as a browser sends it, by a protocol-level
 
 from __future__ import annotations
 
+import asyncio
 import math
 import time
 from collections.abc import Iterator
 from dataclasses import fields
 
 import pytest
+import viser
 
 from rns_viz.live.loop.commands import Scrub
 from rns_viz.out_of_range import OutOfRange, readable, split_label
@@ -266,3 +268,27 @@ def test_a_numbers_beginning_is_told_from_text_that_is_no_number() -> None:
         assert is_unfinished_number(text), text
     for text in ("1", "1.", "-0", "1e-3", "abc", "NaN", "e", "--", "1e-3x", "0x"):
         assert not is_unfinished_number(text), text
+
+
+def test_text_just_typed_is_not_written_over_before_it_is_read(
+    typing_app: tuple[RnsApp, ProtocolClient, Told], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """viser sets a box's value when a client's text arrives and runs the box's callbacks after: the server
+    writing the box in between (the render thread shows values every frame) must not replace the text the
+    callback then reads. Played in that order here: the client's text set as viser sets it, the render
+    thread's write, then the callback."""
+    app, _, told = typing_app
+    g_b = app.gui.gains["g_b"]
+    applied = g_b_applied(app, monkeypatch)
+    before = len(told)
+    state = g_b.box._impl  # what viser's handler sets before it runs the callbacks
+    state.value, state.update_timestamp = "1e9", time.time()
+    g_b.show_text()  # the render thread, between the two
+    app.controls.show(g_b, app.controls.good(g_b))  # (and the settings shown again)
+    assert g_b.box.value == "1e9", "the server wrote over a client's text not yet read"
+    client = next(iter(app.server.get_clients().values()))
+    (keystroke,) = [cb for cb in state.update_cb if cb.__name__ == "keystroke"]
+    event = viser.GuiEvent(client, client.client_id, g_b.box)
+    asyncio.run_coroutine_threadsafe(keystroke(event), app.server._event_loop).result(10.0)
+    wait_until(lambda: len(told) > before and not g_b.typing(), 10.0, "the typed text to be read")
+    assert applied == [1e9] and "not 10⁹" in told[-1][1]

@@ -77,6 +77,9 @@ class NumberField:
         self._range = (float(min), float(max))  # the slider's range when no value lies beyond it
         self._lock = threading.Lock()
         self._timers: dict[int, threading.Timer] = {}  # client id -> the pause it waits for
+        # The box's update time (viser's) when the server last wrote it or took a client's text: a later one is
+        # a client's text not yet taken, which the server must not write over (see on_typed).
+        self._box_seen = self.box.update_timestamp
 
     # ------------------------------------------------------------------ what the field shows
     @property
@@ -87,13 +90,21 @@ class NumberField:
     def value(self, value: float) -> None:
         self._fit_range(value)
         self.slider.value = value
-        if not self.typing():
-            self.box.value = shown(value)
+        self._write_box(shown(value))
 
     def show_text(self) -> None:
         """Write the value in the box again (after a refused or a canonicalised typed number)."""
-        if not self.typing() and self.box.value != shown(self.value):
-            self.box.value = shown(self.value)
+        if self.box.value != shown(self.value):
+            self._write_box(shown(self.value))
+
+    def _write_box(self, text: str) -> None:
+        """Write ``text`` in the box unless it is a client's: typed text waiting for its pause, or just arrived
+        and not taken yet (viser sets the box's value, then runs its callbacks)."""
+        with self._lock:
+            if self._timers or self.box.update_timestamp > self._box_seen:
+                return
+            self.box.value = text
+            self._box_seen = self.box.update_timestamp
 
     def typing(self) -> bool:
         """A client's typed text waits for its pause: the box is theirs until then."""
@@ -161,7 +172,9 @@ class NumberField:
     def on_typed(self, typed: Typed) -> None:
         """Call ``typed(client, text)`` once a client's typing in the box has paused."""
 
-        def keystroke(event: viser.GuiEvent) -> None:
+        # Run on viser's event loop right after it set the box's value (a coroutine: not queued to its thread
+        # pool, where the render thread could write the box over the text before it is read here).
+        async def keystroke(event: viser.GuiEvent) -> None:
             client = event.client
             if client is None:  # the server wrote the box
                 return
@@ -170,6 +183,7 @@ class NumberField:
                 if waiting is not None:
                     waiting.cancel()
                 text = str(event.target.value)  # now: the server may write the box before the pause ends
+                self._box_seen = max(self._box_seen, self.box.update_timestamp)
                 pause = UNFINISHED_PAUSE_S if is_unfinished_number(text) else TYPING_PAUSE_S
                 timer = threading.Timer(pause, self._paused, (client, typed, text))
                 timer.daemon = True
