@@ -292,3 +292,7 @@ def test_text_just_typed_is_not_written_over_before_it_is_read(
     asyncio.run_coroutine_threadsafe(keystroke(event), app.server._event_loop).result(10.0)
     wait_until(lambda: len(told) > before and not g_b.typing(), 10.0, "the typed text to be read")
     assert applied == [1e9] and "not 10⁹" in told[-1][1]
+    # A text whose callback never ran (its page left in between) is written over once it is that old.
+    state.value, state.update_timestamp = "7", time.time() - number_field.UNTAKEN_S
+    g_b.show_text()
+    assert g_b.box.value == shown(g_b.value)

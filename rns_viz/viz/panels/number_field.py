@@ -15,6 +15,7 @@ throttled channel as the text, and a submit within 50 ms of the last keystroke r
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable
 
 import viser
@@ -25,6 +26,7 @@ TYPING_PAUSE_S = 0.8  # s: typed text is read this long after its last keystroke
 # s: ... or this long if it is a number's beginning ("1e-"): someone is typing an exponent, or a busy
 # machine delivered the keys late; a half-typed number is not refused as "not a number" after a short pause
 UNFINISHED_PAUSE_S = 3.0
+UNTAKEN_S = 2.0  # s: a client's text the box's callback has not taken by then never will be (the page left)
 # Hides the number box viser puts beside every slider (it mangles typed numbers); each slider of the
 # app is a NumberField, whose text box shows and takes the value instead.
 SLIDER_BOX_CSS = "<style>.mantine-Slider-root + .mantine-NumberInput-root { display: none; }</style>"
@@ -101,7 +103,10 @@ class NumberField:
         """Write ``text`` in the box unless it is a client's: typed text waiting for its pause, or just arrived
         and not taken yet (viser sets the box's value, then runs its callbacks)."""
         with self._lock:
-            if self._timers or self.box.update_timestamp > self._box_seen:
+            stamp = self.box.update_timestamp
+            # (a text whose callback never ran, its page gone in between, is the server's again after a while)
+            untaken = stamp > self._box_seen and time.time() - stamp < UNTAKEN_S
+            if self._timers or untaken:
                 return
             self.box.value = text
             self._box_seen = self.box.update_timestamp
