@@ -6,6 +6,7 @@ first once the byte budget is spent."""
 from __future__ import annotations
 
 import pickle
+import threading
 from collections.abc import Iterator
 
 import numpy as np
@@ -17,12 +18,16 @@ from rns_viz.model import FsmsModel
 
 @pytest.fixture
 def computed(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[str]]:
-    """The names of the jobs sent to the helper process, an empty cache to start with."""
+    """The names of the jobs this test's thread sent to the helper process, an empty cache to start with.
+    (Only this thread's: in the suite's worker, a session an earlier test stopped may still have a request
+    waiting for the helper, which it sends during this test.)"""
     sent: list[str] = []
     run = jobs._Helper._run
+    ours = threading.current_thread()
 
     def counting(helper: jobs._Helper, name: str, request: bytes) -> bytes:
-        sent.append(name)
+        if threading.current_thread() is ours:
+            sent.append(name)
         return run(helper, name, request)
 
     monkeypatch.setattr(jobs._Helper, "_run", counting)
