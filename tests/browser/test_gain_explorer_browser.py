@@ -33,6 +33,7 @@ from rns_viz.viz.scene.gain_scene import (
 )
 from rns_viz.viz.scene.view_toggles import TOGGLES
 from rns_viz.viz.server.app import RnsApp, start_app
+from tests.browser.test_stage_browser import shown_size
 from tests.support.browser import (
     browser_page,
     dismiss_notifications,
@@ -209,7 +210,7 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     # made it reach over the map's top rows in CI); the map is faced below where it stands expanded.
     app.server.gui.main_panel.minimize()
     # the scene's own canvas as laid out now, between the docked panels (the camera's size may predate them)
-    width, height = scene_canvas_size(page)
+    width, height = shown_size(page)
     panel = main_panel_box(width, height)
     below = panel[3] if panel is not None else 0.0  # px: the rows above are partly under the main panel
     free = height - below
@@ -224,16 +225,6 @@ def face_the_map(app: RnsApp, page: Page, scene: GainScene) -> None:
     cam.look_at = scene.centre - shift
     FACED[client.client_id] = (np.array(cam.position, dtype=float), (width, height))
     wait_for_frames(page, 10)
-
-
-def scene_canvas_size(page: Page) -> tuple[int, int]:
-    """The scene's canvas as laid out now (CSS px), between the docked panels."""
-    width, height = page.evaluate(
-        "() => { const c = [...document.querySelectorAll('canvas')].sort((a, b) =>"
-        " b.clientWidth * b.clientHeight - a.clientWidth * a.clientHeight)[0];"
-        " return [c.clientWidth, c.clientHeight]; }"
-    )
-    return int(width), int(height)
 
 
 def page_framing(app: RnsApp, client: ClientHandle) -> str:
@@ -262,7 +253,7 @@ def face_again_if_framed(app: RnsApp, page: Page, scene: GainScene) -> None:
     position, size = faced
     here = np.asarray(client.camera.position, dtype=float)
     moved = not np.allclose(here, position, atol=1e-4 * max(float(np.linalg.norm(position - scene.centre)), 1e-3))
-    now = scene_canvas_size(page)
+    now = shown_size(page)
     resized = max(abs(now[0] - size[0]), abs(now[1] - size[1])) > 2
     if not (moved or resized):
         return
